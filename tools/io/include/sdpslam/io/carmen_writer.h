@@ -1,0 +1,36 @@
+#pragma once
+// Writes CARMEN logs (the simulator's output, the `convert` subcommand's). Lines follow
+// ../shared/datasets/README.md: ODOM x y theta tv rv accel ipc_ts host logger_ts, and
+// FLASER / ROBOTLASER1 with the laser's geometry. Stamps are printed to the microsecond.
+// The file is written to a temporary name and renamed into place on close() (atomic).
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "sdpslam/io/log_reader.h"
+
+namespace sdpslam::io {
+
+class CarmenWriter {
+ public:
+  CarmenWriter();
+  ~CarmenWriter();  // abandons (removes) an unclosed temporary file
+  CarmenWriter(const CarmenWriter&) = delete;
+  CarmenWriter& operator=(const CarmenWriter&) = delete;
+
+  bool open(const std::string& path, std::string* error);
+  void comment(const std::string& text);
+  void param(const std::string& name, const std::string& value);
+  void odom(const OdomRecord& r);
+  // FLASER when the scan covers exactly 180 deg from -90 deg with range_max equal to the
+  // FLASER convention; otherwise ROBOTLASER1 so that the geometry is not lost.
+  void laser(const LaserRecord& r);
+  // Flushes, fsyncs and renames into place; false iff any write failed.
+  bool close(std::string* error);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sdpslam::io

@@ -1,0 +1,135 @@
+#pragma once
+// Streaming readers of robot logs: CARMEN (.clf, optionally .gz), tinySLAM's one-line-
+// per-scan format, and DP-SLAM's Odometry/Laser format. Host-side (tools/), not core/.
+//
+// The reader hands out one record at a time and never holds the whole log. A malformed
+// line never stops the read: it is skipped and reported as a LogError naming the file,
+// the 1-based line number and the reason; every good record before and after it is
+// delivered. Nothing is silently misread: a line either parses completely and passes
+// its consistency checks, or it is an error.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sdpslam/core/pose2.h"
+#include "sdpslam/core/range_scan.h"
+
+namespace sdpslam::io {
+
+enum class LogFormat {
+  kAuto,      // from content: CARMEN keywords, "Odometry"/"Laser", or tinySLAM numeric lines
+  kCarmen,
+  kTinySlam,
+  kDpSlam,
+};
+
+const char* to_string(LogFormat f);
+
+struct LogError {
+  std::string file;
+  std::int64_t line = 0;  // 1-based
+  std::string reason;
+  std::string to_string() const;  // "file:line: reason"
+};
+
+// A laser scan with everything the log says about it.
+struct LaserRecord {
+  std::string keyword;              // FLASER, RLASER, ROBOTLASER1, tinyslam, dpslam
+  std::int64_t stamp_us = 0;        // CARMEN ipc_timestamp, exact to the microsecond;
+                                    // tinySLAM: field 1; DP-SLAM: synthetic, index * 100 ms
+  std::int64_t logger_stamp_us = 0; // CARMEN logger_timestamp (0 when the format has none)
+  bool has_stamp = true;            // false for DP-SLAM logs (stamps are synthetic)
+  RangeScan scan;                   // ranges and beam geometry; scan.stamp_us == stamp_us
+  Pose2 laser_pose;                 // CARMEN: pose of the laser in the log's world frame
+  bool has_laser_pose = false;
+  Pose2 odom_pose;                  // robot odometry pose at the scan
+  bool has_odom_pose = false;
+  std::int64_t line = 0;
+};
+
+struct OdomRecord {
+  std::int64_t stamp_us = 0;
+  std::int64_t logger_stamp_us = 0;
+  Pose2 pose;
+  double tv_mps = 0.0;
+  double rv_radps = 0.0;
+  std::int64_t line = 0;
+};
+
+struct ParamRecord {
+  std::string name;
+  std::string value;
+  std::int64_t line = 0;
+};
+
+// Robot constants for formats that carry raw wheel ticks (tinySLAM). Defaults are the
+// "MinesRover" of tinyslam-exp2.dat: 2000 ticks/rev, wheel radius 77 mm, half axle 165 mm.
+struct WheelOdometryParams {
+  double ticks_per_rev = 2000.0;
+  double wheel_radius_m = 0.077;
+  double wheel_separation_m = 0.330;
+};
+
+struct LogReaderOptions {
+  LogFormat format = LogFormat::kAuto;
+  WheelOdometryParams wheels;
+  // A beam reading at or above this is treated as "no return" when the log does not
+  // carry a maximum range itself (FLASER, DP-SLAM). Metres.
+  float default_range_max_m = 50.0F;
+  // Errors kept in errors(); more are counted in error_count() only.
+  std::size_t max_errors_kept = 1000;
+};
+
+class LogReader {
+ public:
+  enum class Next { kLaser, kOdom, kParam, kEnd };
+
+  LogReader();
+  ~LogReader();
+  LogReader(const LogReader&) = delete;
+  LogReader& operator=(const LogReader&) = delete;
+
+  // Opens `path` (".gz" read through zlib). False iff it cannot be opened or the format
+  // cannot be detected; `error` then says why.
+  bool open(const std::string& path, const LogReaderOptions& options, std::string* error);
+
+  // Advances to the next good record, skipping (and recording) malformed lines.
+  Next next();
+
+  // The current record; valid until the next call to next().
+  const LaserRecord& laser() const;
+  const OdomRecord& odom() const;
+  const ParamRecord& param() const;
+
+  LogFormat format() const;
+  const std::vector<LogError>& errors() const;
+  std::size_t error_count() const;
+  std::int64_t lines_read() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Parses one line of a CARMEN log in isolation (exposed for tests and the fuzzer).
+// Returns kLaser/kOdom/kParam on success, kEnd for a blank line or comment or an
+// ignored message type (e.g. SYNC, TRUEPOS), and sets *reason (non-empty) iff the line
+// is malformed.
+LogReader::Next parse_carmen_line(const std::string& line, const LogReaderOptions& options,
+                                  LaserRecord* laser, OdomRecord* odom, ParamRecord* param,
+                                  std::string* reason);
+
+// Reads a whole log into memory (for tools and tests; the core never does this).
+struct LogContents {
+  std::vector<LaserRecord> lasers;
+  std::vector<OdomRecord> odoms;
+  std::vector<ParamRecord> params;
+  std::vector<LogError> errors;
+  std::size_t error_count = 0;
+  LogFormat format = LogFormat::kAuto;
+};
+bool read_whole_log(const std::string& path, const LogReaderOptions& options, LogContents* out,
+                    std::string* error);
+
+}  // namespace sdpslam::io
