@@ -3,6 +3,7 @@
 // fsync, rename over the target (and fsync the directory). A reader of `path` sees
 // either the old complete file or the new complete file, never a torn one, even if the
 // process dies mid-write.
+#include <cstdio>
 #include <string>
 
 namespace sdpslam::io {
@@ -11,6 +12,30 @@ namespace sdpslam::io {
 // the path and the failing call with strerror. On failure the old file is untouched and
 // the temporary is removed.
 bool write_file_atomic(const std::string& path, const std::string& contents, std::string* error);
+
+// Streaming variant for large outputs (logs): write through stream(), then commit().
+// Destroying an uncommitted file removes the temporary; the target is never touched.
+class AtomicOutputFile {
+ public:
+  AtomicOutputFile() = default;
+  ~AtomicOutputFile();
+  AtomicOutputFile(const AtomicOutputFile&) = delete;
+  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+
+  // Creates the temporary beside `path`. False (with `error`) iff that fails.
+  bool open(const std::string& path, std::string* error);
+  std::FILE* stream() { return file_; }
+  // Flushes, fsyncs, renames over the target. False iff any step or any earlier write
+  // failed (checked through ferror), with `error` naming the path and the cause.
+  bool commit(std::string* error);
+  // Drops the temporary without touching the target.
+  void abandon();
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::string temp_path_;
+};
 
 // Creates `dir` and its parents if missing. False (with `error`) iff that fails.
 bool make_directories(const std::string& dir, std::string* error);
