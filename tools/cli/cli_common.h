@@ -1,0 +1,58 @@
+#pragma once
+// Shared pieces of the `sdpslam` command line: exit codes, subcommand registration and
+// a progress line for long work.
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace sdpslam::cli {
+
+// Exit codes: scripts can tell bad input from a fault of the program.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitInternal = 1,   // a bug or an unexpected failure inside sdpslam
+  kExitUsage = 2,      // bad command line (CLI11 parse errors)
+  kExitBadInput = 3,   // unreadable, malformed or inconsistent input data
+  kExitIo = 4,         // an output could not be written
+};
+
+// A subcommand: `setup` adds options to its CLI::App and returns the function that runs
+// it after parsing (the function returns an ExitCode).
+using CommandSetup = std::function<std::function<int()>(CLI::App&)>;
+
+struct CommandInfo {
+  const char* name;
+  const char* description;
+  int order;  // position in --help
+  CommandSetup setup;
+};
+
+// Called by SDPSLAM_REGISTER_COMMAND at static-initialisation time.
+bool register_command(const CommandInfo& info);
+
+#define SDPSLAM_REGISTER_COMMAND(ident, name, description, order, setup_fn) \
+  static const bool sdpslam_cli_registered_##ident =                        \
+      ::sdpslam::cli::register_command(::sdpslam::cli::CommandInfo{name, description, order, setup_fn})
+
+// A one-line progress display on stderr ("scans 1200/13631  8.8%  412 scans/s  ETA 0:31"),
+// drawn only when stderr is a terminal and at most ~5 times a second. Silent otherwise.
+class Progress {
+ public:
+  Progress(std::string what, std::uint64_t total);
+  ~Progress();
+  void update(std::uint64_t done);
+  void finish();
+
+ private:
+  std::string what_;
+  std::uint64_t total_;
+  bool enabled_;
+  bool finished_ = false;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+};
+
+}  // namespace sdpslam::cli

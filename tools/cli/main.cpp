@@ -1,0 +1,85 @@
+// sdpslam: simulate, convert, evaluate and run SLAM on robot logs.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "cli_common.h"
+#include "sdpslam/core/version.h"
+
+namespace sdpslam::cli {
+namespace {
+std::vector<CommandInfo>& registry() {
+  static std::vector<CommandInfo> commands;
+  return commands;
+}
+}  // namespace
+
+bool register_command(const CommandInfo& info) {
+  registry().push_back(info);
+  return true;
+}
+
+Progress::Progress(std::string what, std::uint64_t total)
+    : what_(std::move(what)), total_(total), enabled_(::isatty(STDERR_FILENO) == 1),
+      start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
+
+Progress::~Progress() { finish(); }
+
+void Progress::update(std::uint64_t done) {
+  if (!enabled_ || finished_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (done < total_ && now - last_draw_ < std::chrono::milliseconds(200)) return;
+  last_draw_ = now;
+  const double elapsed_s = std::chrono::duration<double>(now - start_).count();
+  const double rate = elapsed_s > 0.0 ? static_cast<double>(done) / elapsed_s : 0.0;
+  const double pct = total_ > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 0.0;
+  const double eta_s = rate > 0.0 && total_ >= done ? static_cast<double>(total_ - done) / rate : 0.0;
+  const int eta = static_cast<int>(eta_s + 0.5);
+  std::fprintf(stderr, "\r%s %llu/%llu %5.1f%%  %.0f %s/s  ETA %d:%02d   ", what_.c_str(),
+               static_cast<unsigned long long>(done), static_cast<unsigned long long>(total_), pct, rate,
+               what_.c_str(), eta / 60, eta % 60);
+  std::fflush(stderr);
+}
+
+void Progress::finish() {
+  if (!enabled_ || finished_) return;
+  finished_ = true;
+  std::fprintf(stderr, "\n");
+}
+
+}  // namespace sdpslam::cli
+
+int main(int argc, char** argv) {
+  using namespace sdpslam::cli;
+  CLI::App app{"sdpslam: Segmented DP-SLAM for wheeled robots (simulate, convert, evaluate, run)"};
+  app.set_version_flag("--version", sdpslam::version_string());
+  app.require_subcommand(1);
+
+  auto& commands = registry();
+  std::sort(commands.begin(), commands.end(),
+            [](const CommandInfo& a, const CommandInfo& b) { return a.order < b.order; });
+  std::vector<std::pair<CLI::App*, std::function<int()>>> runners;
+  for (const CommandInfo& c : commands) {
+    CLI::App* sub = app.add_subcommand(c.name, c.description);
+    runners.emplace_back(sub, c.setup(*sub));
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    for (auto& [sub, run] : runners) {
+      if (sub->parsed()) return run();
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sdpslam: internal error: %s\n", e.what());
+    return kExitInternal;
+  }
+  return kExitUsage;
+}
