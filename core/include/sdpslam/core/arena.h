@@ -44,14 +44,16 @@ class Arena {
   // Typed array of `count` default-initialised Ts; nullptr iff out of room.
   template <typename T>
   T* allocate_array(std::size_t count) {
-    if (count > (capacity_bytes_ / (sizeof(T) > 0U ? sizeof(T) : 1U)) + 1U) {
+    constexpr std::size_t kElem = sizeof(T) > 0U ? sizeof(T) : 1U;
+    if (count > available_bytes() / kElem) {  // also rules out overflow of count * kElem
       ++oom_count_;
       return nullptr;
     }
-    void* p = allocate(sizeof(T) * count, alignof(T));
+    const std::size_t bytes = count * kElem;
+    void* p = allocate(bytes, alignof(T));
     if (p == nullptr) return nullptr;
     T* typed = static_cast<T*>(p);
-    for (std::size_t i = 0; i < count; ++i) new (&typed[i]) T();
+    for (std::size_t done = 0; done < bytes; done += kElem) new (&typed[done / kElem]) T();
     return typed;
   }
 
