@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# The two quick-start commands of README.md.
+#
+#   tools/quickstart.sh demo   install what is missing, build (host-release), simulate the
+#                              paper's world, run SLAM on it, write its map and trajectory
+#                              and print its accuracy
+#   tools/quickstart.sh test   install what is missing, build and run the whole test suite:
+#                              host (debug), ASan+UBSan, aarch64 under qemu, fuzzers
+#
+# Works on a fresh Debian 12 with a compiler and CMake; installs Debian packages as root
+# or through sudo. Environment: SDPSLAM_JOBS (parallel build jobs, default: nproc),
+# SDPSLAM_FUZZ_SECONDS (per fuzzer, default 20), SDPSLAM_SKIP_INSTALL=1 (no apt-get).
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$here"
+mode=${1:-}
+jobs=${SDPSLAM_JOBS:-$(nproc)}
+
+log() { printf '\n== %s\n' "$*"; }
+die() { printf 'quickstart: %s\n' "$*" >&2; exit 1; }
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@";
+  else die "need root or sudo to install: $*"; fi
+}
+
+# Packages for the host build and tests; cross and fuzz extras for `test`.
+host_pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libcpputest-dev libpng-dev zlib1g-dev
+           libcli11-dev libinih-dev)
+test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user)
+arm64_pkgs=(libcpputest-dev:arm64)
+
+missing() {
+  local p out=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || out+=("$p")
+  done
+  echo "${out[@]:-}"
+}
+
+apt_updated=0
+install() {
+  [ "${SDPSLAM_SKIP_INSTALL:-0}" = 1 ] && return 0
+  local need
+  need=$(missing "$@")
+  [ -z "$need" ] && return 0
+  log "installing: $need"
+  if [ $apt_updated = 0 ]; then
+    # A mirror caught mid-sync can fail one index; what is needed may still install.
+    as_root apt-get update -qq || echo "quickstart: apt-get update reported errors; trying the install anyway" >&2
+    apt_updated=1
+  fi
+  # shellcheck disable=SC2086
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $need
+}
+
+configure_build() {  # preset
+  log "build: $1"
+  cmake --preset "$1" >"build/$1.configure.log" 2>&1 || { cat "build/$1.configure.log"; die "configure $1 failed"; }
+  cmake --build --preset "$1" -j "$jobs"
+}
+
+case "$mode" in
+  demo)
+    install "${host_pkgs[@]}"
+    mkdir -p build
+    configure_build host-release
+    bin=build/host-release/tools/cli/sdpslam
+    out=out/demo
+    log "simulate the paper's world (inner loop 28 m, outer loop 80 m) -> $out/sim"
+    "$bin" simulate --out "$out/sim"
+    if "$bin" run --help >/dev/null 2>&1; then
+      log "run SLAM on it -> $out/run"
+      "$bin" run "$out/sim/sim.clf" --out "$out/run"
+      log "accuracy against ground truth"
+      "$bin" evaluate --trajectory "$out/run/trajectory.txt" --ground-truth "$out/sim/ground_truth.txt"
+      echo "map: $out/run/map.png  trajectory: $out/run/trajectory.txt"
+    else
+      echo "map: $out/sim/world.png  log: $out/sim/sim.clf  ground truth: $out/sim/ground_truth.txt"
+    fi
+    ;;
+  test)
+    if [ "${SDPSLAM_SKIP_INSTALL:-0}" != 1 ] && ! dpkg --print-foreign-architectures | grep -qx arm64; then
+      as_root dpkg --add-architecture arm64
+      apt_updated=0
+    fi
+    install "${host_pkgs[@]}" "${test_pkgs[@]}" "${arm64_pkgs[@]}"
+    [ -d ../shared ] || echo "quickstart: ../shared is absent: tests that need the benchmark logs and sensor captures will be reported as skipped" >&2
+    mkdir -p build
+    start=$(date +%s)
+    failed=()
+    for preset in host-debug host-asan aarch64 fuzz; do
+      if ! configure_build "$preset"; then failed+=("$preset(build)"); continue; fi
+      log "test: $preset"
+      if [ "$preset" = fuzz ]; then
+        export SDPSLAM_FUZZ_SECONDS=${SDPSLAM_FUZZ_SECONDS:-20}
+      fi
+      ctest --preset "$preset" -j "$jobs" || failed+=("$preset")
+    done
+    log "whole suite took $(( $(date +%s) - start )) s"
+    if [ ${#failed[@]} -gt 0 ]; then
+      echo "FAILED: ${failed[*]}"
+      exit 1
+    fi
+    echo "all test presets passed: host-debug host-asan aarch64 fuzz"
+    ;;
+  *)
+    sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
+    exit 2
+    ;;
+esac
