@@ -26,3 +26,27 @@ inline constexpr std::uint32_t kMaxBeams = SDPSLAM_MAX_BEAMS;
 static_assert(kMaxBeams >= 2U && kMaxBeams <= 4096U, "kMaxBeams out of range");
 
 }  // namespace sdpslam::capacity
+
+// ---- Ancestry tree and distributed particle map (DP-Mapping, paper §II-A) ----------
+namespace sdpslam::capacity {
+
+#ifndef SDPSLAM_DP_TILE_SIDE_LOG2
+#define SDPSLAM_DP_TILE_SIDE_LOG2 4
+#endif
+
+// Ancestry-tree nodes to provision per bottom-level particle: after prune the tree holds
+// at most 2·N − 1 nodes, and resampling adds N children before the next prune.
+inline constexpr std::uint32_t kAncestryNodesPerParticle = 3U;
+static_assert(static_cast<std::uint64_t>(kMaxBottomParticles) * kAncestryNodesPerParticle < 0x7FFFFFFFULL,
+              "ancestry node ids must fit NodeId with room for the kNoNode marker");
+
+// DpMap tiles are square blocks of 2^k × 2^k cells allocated on first write, so that
+// unexplored space costs one u32 index entry per tile (16×16 cells = 1 KiB by default).
+inline constexpr std::uint32_t kDpTileSideLog2 = SDPSLAM_DP_TILE_SIDE_LOG2;
+static_assert(kDpTileSideLog2 >= 2U && kDpTileSideLog2 <= 6U, "kDpTileSideLog2 out of range [2,6]");
+inline constexpr std::uint32_t kDpTileSideCells = 1U << kDpTileSideLog2;
+inline constexpr std::uint32_t kDpTileCells = kDpTileSideCells * kDpTileSideCells;
+// A DpMap observation addresses its cell as (tile slot << 2k) | cell-in-tile in 32 bits.
+inline constexpr std::uint32_t kDpMaxTiles = 0xFFFFFFFFU >> (2U * kDpTileSideLog2);
+
+}  // namespace sdpslam::capacity

@@ -1,0 +1,276 @@
+#pragma once
+// Distributed particle map (DP-Mapping, paper §II-A; Eliazar & Parr, DP-SLAM 2003 §3.2).
+//
+// One grid shared by all particles. Each cell holds a short list of observations, each
+// made by one ancestry-tree node; a particle sees, in every cell, the observation of its
+// nearest ancestor-or-self that has one ("to obtain the full map associated to a
+// particle it is necessary to consult the observations made by the particle and by its
+// ancestrals"). A copy of a particle's map at resampling is thus free: the child simply
+// inherits.
+//
+// Layout (fixed memory, all from the Arena at init):
+//  - a tile index table, one u32 per tile of kDpTileSideCells² cells, covering the area;
+//  - tiles (cell list heads) from a pool, allocated on the first write into the tile and
+//    released when their last observation goes, so unexplored space costs 4 bytes/tile;
+//  - observations (20 bytes: node, cell link, node link, cell address, value) from a
+//    pool; each node keeps an intrusive list of the observations it owns, so the tree's
+//    prune/merge (TreeListener) costs O(observations of that node × cell list length);
+//  - a per-node list head table sized by the tree's capacity.
+//
+// Ownership: the map keeps a reference to the AncestryTree given to init() (it must
+// outlive the map) and reads it for ancestor queries; the tree tells the map about
+// removals and merges through prune(&map). Lookups must not run concurrently with
+// prune or updates (single-threaded filter; concurrent lookups alone are fine).
+//
+// Errors are results and counters: out-of-area coordinates, exhausted pools and dead
+// node ids make update() return false with a counter bumped; the map stays consistent.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/arena.h"
+#include "sdpslam/core/capacities.h"
+#include "sdpslam/core/pool.h"
+
+namespace sdpslam {
+
+// The value one ancestry node recorded for one cell. How the filter turns it into an
+// occupancy probability is its business (e.g. hits / (hits + misses)).
+struct CellObservation {
+  std::uint16_t hits = 0U;
+  std::uint16_t misses = 0U;
+};
+inline bool operator==(const CellObservation& a, const CellObservation& b) {
+  return a.hits == b.hits && a.misses == b.misses;
+}
+inline bool operator!=(const CellObservation& a, const CellObservation& b) { return !(a == b); }
+
+// base + (add_hits, add_misses) with saturation that keeps the ratio: while either count
+// would reach 65535, both are halved (rounding down). Pure, O(1).
+inline CellObservation accumulate(CellObservation base, std::uint16_t add_hits, std::uint16_t add_misses) {
+  std::uint32_t h = static_cast<std::uint32_t>(base.hits) + add_hits;
+  std::uint32_t m = static_cast<std::uint32_t>(base.misses) + add_misses;
+  while (h >= 0xFFFFU || m >= 0xFFFFU) {
+    h >>= 1U;
+    m >>= 1U;
+  }
+  return CellObservation{static_cast<std::uint16_t>(h), static_cast<std::uint16_t>(m)};
+}
+
+// Half-open rectangle of cells [ix0, ix0 + width) × [iy0, iy0 + height).
+struct CellRect {
+  std::int32_t ix0 = 0;
+  std::int32_t iy0 = 0;
+  std::uint32_t width = 0U;
+  std::uint32_t height = 0U;
+};
+
+class DpMap final : public TreeListener {
+ public:
+  struct Options {
+    double origin_x_m = 0.0;  // world coordinates of the lower-left corner of cell (0,0)
+    double origin_y_m = 0.0;
+    double width_m = 0.0;     // covered area; rounded up to whole cells
+    double height_m = 0.0;
+    double resolution_m = 0.05;           // cell side
+    std::uint32_t tile_capacity = 0U;     // tiles that may hold data at once
+    std::uint32_t observation_capacity = 0U;  // (node, cell) observations at once
+  };
+
+  DpMap() = default;
+  DpMap(const DpMap&) = delete;
+  DpMap& operator=(const DpMap&) = delete;
+  ~DpMap() = default;
+
+  // Arena bytes init() needs for `options` and a tree of `node_capacity` nodes
+  // (alignment padding included); 0 iff the options are invalid.
+  static std::size_t required_arena_bytes(const Options& options, std::uint32_t node_capacity);
+  // True iff the options describe a usable map: finite origin, width/height/resolution
+  // > 0, cells per axis < 2^31 and the tile table < 2^32 entries, 1 ≤ tile_capacity ≤
+  // capacity::kDpMaxTiles, observation_capacity ≥ 1.
+  static bool options_valid(const Options& options);
+
+  // Validates `options`, keeps a reference to `tree` (initialised first: its capacity
+  // sizes the per-node table) and carves all storage from `arena`. Returns false iff the
+  // options are invalid, the tree is not initialised, or the arena is too small (the map
+  // is then unusable and every update is refused). Call once.
+  bool init(Arena& arena, const Options& options, const AncestryTree& tree);
+
+  // ---- geometry ----------------------------------------------------------------------
+  std::int32_t width_cells() const { return width_cells_; }
+  std::int32_t height_cells() const { return height_cells_; }
+  double resolution_m() const { return options_.resolution_m; }
+  const Options& options() const { return options_; }
+  bool in_bounds(std::int32_t ix, std::int32_t iy) const {
+    return ix >= 0 && iy >= 0 && ix < width_cells_ && iy < height_cells_;
+  }
+  // Cell containing world point (x_m, y_m) (floor). False iff outside the covered area
+  // (outputs untouched) or not a finite number.
+  bool world_to_cell(double x_m, double y_m, std::int32_t* ix, std::int32_t* iy) const;
+  // World coordinates of the centre of cell (ix, iy); no bounds check.
+  void cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y_m) const;
+
+  // ---- the particle's view -----------------------------------------------------------
+  // The observation of `particle`'s deepest ancestor-or-self that has one in cell
+  // (ix, iy). False (and *out untouched) iff none has one, the cell is outside the map,
+  // or `particle` is dead. Cost: tile table → cell head → scan of that cell's list with
+  // an O(1) ancestor test per entry; no walk up the tree.
+  bool lookup(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation* out) const {
+    if (!in_bounds(ix, iy)) return false;
+    const std::uint32_t tile = tile_table_[tile_index(ix, iy)];
+    if (tile == kNone) return false;
+    return resolve(particle, tiles_[tile].head[cell_in_tile(ix, iy)], out);
+  }
+
+  // Sets `particle`'s own observation of cell (ix, iy) to `value`: in place if it has
+  // one there, else a new entry in the cell's and the node's lists (it then shadows the
+  // ancestors' for `particle` and its descendants only). Returns false iff the update is
+  // dropped — the degraded path, after which the map is unchanged and consistent:
+  // out of the area (out_of_bounds_count), a tile is needed and none is free
+  // (tile_oom_count), an observation is needed and none is free (observation_oom_count),
+  // or `particle` is not a live tree node (misuse_count). O(cell list length).
+  bool update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation value);
+  // lookup() then accumulate() then update(): the particle's own record becomes its
+  // current view plus the new evidence. Same result and failure rules as update().
+  bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
+
+  // ---- extraction --------------------------------------------------------------------
+  // Calls f(ix, iy, const CellObservation&) for every cell `particle` knows, in raster
+  // order of tiles (row-major) and of cells within a tile. O(tiles in table + cells of
+  // touched tiles × list length).
+  template <class F>
+  void for_each_known_cell(NodeId particle, F&& f) const;
+  // Fills row-major buffers of rect.width × rect.height with `particle`'s view:
+  // values[i] (left untouched where unknown) and known[i] ∈ {0,1}. Cells outside the
+  // map are unknown. Returns the number of known cells.
+  std::uint32_t fill_rect(NodeId particle, const CellRect& rect, CellObservation* values,
+                          std::uint8_t* known) const;
+  // Bounding rectangle (whole tiles, clipped to the map) of every tile ever written.
+  // False iff nothing was ever written.
+  bool touched_bounds(CellRect* out) const;
+  // Entries (of all nodes) in one cell's list; 0 outside the map. For diagnostics/tests.
+  std::uint32_t entries_in_cell(std::int32_t ix, std::int32_t iy) const;
+  // Observations owned by `node`. O(that count).
+  std::uint32_t observation_count(NodeId node) const;
+
+  // ---- TreeListener (called by AncestryTree::prune) ----------------------------------
+  // Frees every observation `node` owns (and tiles left empty).
+  void on_node_removed(NodeId node) override;
+  // Gives `parent`'s observations to `child`, except in cells where `child` has its own
+  // (newer) one: there the parent's is freed.
+  void on_node_merged(NodeId parent, NodeId child) override;
+
+  // ---- accounting --------------------------------------------------------------------
+  std::uint32_t tiles_used() const { return tiles_pool_.size(); }
+  std::uint32_t tiles_peak() const { return tiles_pool_.peak_used(); }
+  std::uint32_t tile_capacity() const { return tiles_pool_.capacity(); }
+  std::uint32_t observations_used() const { return obs_pool_.size(); }
+  std::uint32_t observations_peak() const { return obs_pool_.peak_used(); }
+  std::uint32_t observation_capacity() const { return obs_pool_.capacity(); }
+  std::uint32_t tile_oom_count() const { return tile_oom_count_; }
+  std::uint32_t observation_oom_count() const { return observation_oom_count_; }
+  std::uint32_t out_of_bounds_count() const { return out_of_bounds_count_; }
+  std::uint32_t misuse_count() const { return misuse_count_; }
+  // Bytes of state: tile table, tile pool, observation pool, node table.
+  std::size_t footprint_bytes() const;
+
+  // Full self-check, O(capacity): pool invariants; every observation is in exactly one
+  // cell list and one node list, and they agree on its node and cell; no node has two
+  // observations in one cell; every node with observations is live in the tree; the
+  // tile table and tile back-references agree; each tile's count equals its entries
+  // and no tile in use is empty; list lengths add up to the pool counts.
+  bool invariants_hold() const;
+
+ private:
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  static constexpr std::uint32_t kSideLog2 = capacity::kDpTileSideLog2;
+  static constexpr std::uint32_t kSideMask = capacity::kDpTileSideCells - 1U;
+
+  struct Observation {
+    NodeId node;
+    std::uint32_t next_in_cell;
+    std::uint32_t next_in_node;
+    std::uint32_t location;  // (tile slot << 2k) | cell in tile
+    CellObservation value;
+  };
+  static_assert(sizeof(Observation) == 20U, "observation entries must stay compact");
+  struct Tile {
+    std::uint32_t head[capacity::kDpTileCells];  // first observation per cell, kNone if empty
+    std::uint32_t count;                         // observations in this tile
+    std::uint32_t table_index;                   // back-reference into tile_table_
+  };
+
+  std::uint32_t tile_index(std::int32_t ix, std::int32_t iy) const {
+    return (static_cast<std::uint32_t>(iy) >> kSideLog2) * tiles_x_ + (static_cast<std::uint32_t>(ix) >> kSideLog2);
+  }
+  static std::uint32_t cell_in_tile(std::int32_t ix, std::int32_t iy) {
+    return ((static_cast<std::uint32_t>(iy) & kSideMask) << kSideLog2) | (static_cast<std::uint32_t>(ix) & kSideMask);
+  }
+
+  // Deepest ancestor-or-self of `particle` among the list starting at `first`.
+  bool resolve(NodeId particle, std::uint32_t first, CellObservation* out) const {
+    if (!tree_->contains(particle)) return false;
+    std::uint32_t best = kNone;
+    std::uint32_t best_depth = 0U;
+    for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
+      const Observation& o = obs_[e];
+      if (o.node == particle) {
+        *out = o.value;
+        return true;
+      }
+      if (tree_->is_ancestor_or_self(o.node, particle)) {
+        const std::uint32_t d = tree_->depth(o.node);
+        if (best == kNone || d > best_depth) {
+          best = e;
+          best_depth = d;
+        }
+      }
+    }
+    if (best == kNone) return false;
+    *out = obs_[best].value;
+    return true;
+  }
+  void unlink_from_cell(std::uint32_t e);
+  void release_observation(std::uint32_t e);
+  std::uint32_t find_in_cell(std::uint32_t first, NodeId node) const;
+  void location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const;
+
+  Options options_{};
+  const AncestryTree* tree_ = nullptr;
+  std::int32_t width_cells_ = 0;
+  std::int32_t height_cells_ = 0;
+  std::uint32_t tiles_x_ = 0U;
+  std::uint32_t tiles_y_ = 0U;
+  std::uint32_t* tile_table_ = nullptr;  // tiles_x_ · tiles_y_ entries: tile slot or kNone
+  ArenaPool<Tile> tiles_pool_;
+  Tile* tiles_ = nullptr;  // slot 0 of tiles_pool_ (slots are contiguous)
+  ArenaPool<Observation> obs_pool_;
+  Observation* obs_ = nullptr;  // slot 0 of obs_pool_
+  std::uint32_t* node_head_ = nullptr;  // per NodeId: first owned observation
+  std::uint32_t node_capacity_ = 0U;
+  std::uint32_t touched_tx0_ = kNone, touched_ty0_ = kNone, touched_tx1_ = 0U, touched_ty1_ = 0U;
+  std::uint32_t tile_oom_count_ = 0U;
+  std::uint32_t observation_oom_count_ = 0U;
+  std::uint32_t out_of_bounds_count_ = 0U;
+  std::uint32_t misuse_count_ = 0U;
+};
+
+template <class F>
+void DpMap::for_each_known_cell(NodeId particle, F&& f) const {
+  if (tree_ == nullptr || !tree_->contains(particle)) return;
+  for (std::uint32_t t = 0U; t < tiles_x_ * tiles_y_; ++t) {
+    const std::uint32_t slot = tile_table_[t];
+    if (slot == kNone) continue;
+    const std::int32_t tx0 = static_cast<std::int32_t>((t % tiles_x_) << kSideLog2);
+    const std::int32_t ty0 = static_cast<std::int32_t>((t / tiles_x_) << kSideLog2);
+    for (std::uint32_t c = 0U; c < capacity::kDpTileCells; ++c) {
+      CellObservation v;
+      if (resolve(particle, tiles_[slot].head[c], &v)) {
+        f(tx0 + static_cast<std::int32_t>(c & kSideMask), ty0 + static_cast<std::int32_t>(c >> kSideLog2),
+          static_cast<const CellObservation&>(v));
+      }
+    }
+  }
+}
+
+}  // namespace sdpslam
