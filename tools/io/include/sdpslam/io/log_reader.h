@@ -30,6 +30,9 @@ struct LogError {
   std::string file;
   std::int64_t line = 0;  // 1-based
   std::string reason;
+  // True when the line was skipped on purpose rather than malformed (a CARMEN message
+  // type this reader does not know); counted with the errors all the same.
+  bool warning = false;
   std::string to_string() const;  // "file:line: reason"
 };
 
@@ -79,6 +82,17 @@ struct LogReaderOptions {
   float default_range_max_m = 50.0F;
   // Errors kept in errors(); more are counted in error_count() only.
   std::size_t max_errors_kept = 1000;
+  // CARMEN FLASER/RLASER lines carry neither the laser's mounting nor its range limit.
+  // These are used instead; PARAM robot_frontlaser_offset, robot_rearlaser_offset,
+  // robot_frontlaser_max / robot_front_laser_max (and the rear ones) in the log override
+  // them from that line on. A max of 0 means default_range_max_m.
+  double front_laser_offset_m = 0.0;
+  double rear_laser_offset_m = 0.0;
+  float front_laser_max_m = 0.0F;
+  float rear_laser_max_m = 0.0F;
+  // tinySLAM: the URG's forward offset from the wheel axle (BreezySLAM examples/mines.py,
+  // MinesLaser: 145 mm).
+  double tinyslam_laser_offset_m = 0.145;
 };
 
 class LogReader {
@@ -104,8 +118,11 @@ class LogReader {
 
   LogFormat format() const;
   const std::vector<LogError>& errors() const;
-  std::size_t error_count() const;
+  std::size_t error_count() const;    // every skipped line, warnings included
+  std::size_t warning_count() const;  // the part of error_count() that are warnings
   std::int64_t lines_read() const;
+  // Bytes of the input file consumed so far (compressed bytes for .gz), for progress.
+  std::uint64_t input_offset() const;
 
  private:
   struct Impl;
@@ -127,6 +144,7 @@ struct LogContents {
   std::vector<ParamRecord> params;
   std::vector<LogError> errors;
   std::size_t error_count = 0;
+  std::size_t warning_count = 0;
   LogFormat format = LogFormat::kAuto;
 };
 bool read_whole_log(const std::string& path, const LogReaderOptions& options, LogContents* out,

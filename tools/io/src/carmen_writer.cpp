@@ -1,0 +1,164 @@
+// CARMEN log writer. Numbers are printed as the shortest decimal that reads back to the
+// same float/double (std::to_chars), so a log written here and read by LogReader gives
+// back exactly the ranges and poses that went in; stamps are exact microseconds.
+#include "sdpslam/io/carmen_writer.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "log_parse.h"
+#include "sdpslam/io/atomic_file.h"
+
+namespace sdpslam::io {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr const char* kHost = "sdpslam";
+
+// FLASER carries neither mounting nor range limit: only a scan that LogReader would
+// rebuild identically from FLASER (default options) is written as one.
+bool fits_flaser(const LaserRecord& r) {
+  const ScanGeometry& g = r.scan.geometry;
+  const std::uint32_t n = r.scan.beam_count;
+  if (n < 2U) return false;
+  const LogReaderOptions defaults;
+  return g.angle_min_rad == static_cast<float>(-kPi / 2.0) &&
+         g.angle_increment_rad == static_cast<float>(kPi / static_cast<double>(n - 1U)) && g.range_min_m == 0.0F &&
+         g.range_max_m == defaults.default_range_max_m && g.laser_in_base.x_m == defaults.front_laser_offset_m &&
+         g.laser_in_base.y_m == 0.0 && g.laser_in_base.heading_rad == 0.0;
+}
+
+std::string one_line(const std::string& text) {
+  std::string out = text;
+  for (char& c : out) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return out;
+}
+
+}  // namespace
+
+struct CarmenWriter::Impl {
+  AtomicOutputFile file;
+  bool open = false;
+  std::string line;
+
+  void put(const std::string& s) {
+    if (open) std::fputs(s.c_str(), file.stream());
+  }
+  void num(double v) {
+    line += detail::format_exact(v);
+    line += ' ';
+  }
+  void numf(float v) {
+    line += detail::format_exact(v);
+    line += ' ';
+  }
+  // RangeScan allows NaN and negative values as invalid beams and +inf as no return; the
+  // reader takes neither, so they are written as 0 (invalid) and range_max (no return).
+  void range(float r, float range_max_m) {
+    if (std::isinf(r) && r > 0.0F && std::isfinite(range_max_m)) {
+      r = range_max_m;
+    } else if (!std::isfinite(r) || r < 0.0F) {
+      r = 0.0F;
+    }
+    numf(r);
+  }
+  void pose(const Pose2& p) {
+    num(p.x_m);
+    num(p.y_m);
+    num(p.heading_rad);
+  }
+  void trailer(std::int64_t ipc_us, std::int64_t logger_us) {
+    line += detail::format_stamp(ipc_us);
+    line += ' ';
+    line += kHost;
+    line += ' ';
+    line += detail::format_stamp(logger_us);
+    line += '\n';
+    put(line);
+  }
+};
+
+CarmenWriter::CarmenWriter() : impl_(std::make_unique<Impl>()) {}
+CarmenWriter::~CarmenWriter() = default;  // AtomicOutputFile removes an uncommitted temporary
+
+bool CarmenWriter::open(const std::string& path, std::string* error) {
+  impl_ = std::make_unique<Impl>();
+  if (!impl_->file.open(path, error)) return false;
+  impl_->open = true;
+  impl_->put(
+      "# CARMEN log written by sdpslam\n"
+      "# message_name [message contents] ipc_timestamp ipc_hostname logger_timestamp\n"
+      "# message formats defined: PARAM ODOM FLASER ROBOTLASER1\n"
+      "# PARAM param_name param_value\n"
+      "# ODOM x y theta tv rv accel\n"
+      "# FLASER num_readings [range_readings] x y theta odom_x odom_y odom_theta\n"
+      "# ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy "
+      "remission_mode num_readings [range_readings] num_remissions [remissions] laser_pose_x laser_pose_y "
+      "laser_pose_theta robot_pose_x robot_pose_y robot_pose_theta laser_tv laser_rv forward_safety_dist "
+      "side_safty_dist turn_axis\n");
+  return true;
+}
+
+void CarmenWriter::comment(const std::string& text) { impl_->put("# " + one_line(text) + "\n"); }
+
+void CarmenWriter::param(const std::string& name, const std::string& value) {
+  impl_->put("PARAM " + one_line(name) + " " + one_line(value) + " 0.000000 " + kHost + " 0.000000\n");
+}
+
+void CarmenWriter::odom(const OdomRecord& r) {
+  Impl& s = *impl_;
+  s.line = "ODOM ";
+  s.pose(r.pose);
+  s.num(r.tv_mps);
+  s.num(r.rv_radps);
+  s.num(0.0);  // accel
+  s.trailer(r.stamp_us, r.logger_stamp_us);
+}
+
+void CarmenWriter::laser(const LaserRecord& r) {
+  Impl& s = *impl_;
+  const RangeScan& scan = r.scan;
+  const ScanGeometry& g = scan.geometry;
+  // Robot (odometry) pose and laser pose, each derived from the other when missing.
+  Pose2 robot = r.odom_pose;
+  Pose2 laser_pose = r.laser_pose;
+  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
+  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
+  const std::uint32_t n = scan.beam_count <= capacity::kMaxBeams ? scan.beam_count : capacity::kMaxBeams;
+
+  if (fits_flaser(r)) {
+    s.line = "FLASER " + std::to_string(n) + " ";
+    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
+    s.pose(laser_pose);
+    s.pose(robot);
+  } else {
+    s.line = "ROBOTLASER1 0 ";
+    s.numf(g.angle_min_rad);
+    s.numf(g.angle_increment_rad * static_cast<float>(n > 0U ? n - 1U : 0U));  // field of view
+    s.numf(g.angle_increment_rad);
+    s.numf(g.range_max_m);
+    s.num(0.0);  // accuracy
+    s.line += "0 " + std::to_string(n) + " ";  // remission_mode, num_readings
+    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
+    s.line += "0 ";  // num_remissions
+    s.pose(laser_pose);
+    s.pose(robot);
+    s.line += "0 0 0 0 0 ";  // tv rv forward_safety_dist side_safety_dist turn_axis
+  }
+  s.trailer(r.stamp_us, r.logger_stamp_us);
+}
+
+bool CarmenWriter::close(std::string* error) {
+  Impl& s = *impl_;
+  if (!s.open) {
+    if (error != nullptr) *error = "CarmenWriter::close: no file is open";
+    return false;
+  }
+  s.open = false;
+  return s.file.commit(error);
+}
+
+}  // namespace sdpslam::io

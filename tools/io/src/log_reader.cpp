@@ -1,0 +1,466 @@
+// Streaming log reader: one line at a time through zlib (which reads plain files as they
+// are), format detection from content, and the tinySLAM and DP-SLAM line formats.
+#include <zlib.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "carmen_parse.h"
+#include "log_parse.h"
+#include "sdpslam/io/log_reader.h"
+
+namespace sdpslam::io {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// tinySLAM / BreezySLAM exp2.dat layout, 0-based fields (BreezySLAM examples/log2pgm.py:
+// toks[0] timestamp, toks[2], toks[3] odometry Q1, Q2, toks[24:] distances; it drops the
+// line's last field): 24 header fields, then 682 URG-04LX ranges for steps 44..725.
+constexpr std::size_t kTinyStampField = 0;
+constexpr std::size_t kTinyLeftTicksField = 2;
+constexpr std::size_t kTinyRightTicksField = 3;
+constexpr std::size_t kTinyFirstRangeField = 24;
+constexpr std::uint32_t kTinyBeams = 682;
+// URG-04LX geometry (protocols.md section 1): angle = (step - 384) * 2 pi / 1024.
+constexpr int kUrgFirstStep = 44;
+constexpr int kUrgFrontStep = 384;
+constexpr double kUrgStepsPerRev = 1024.0;
+constexpr int kUrgMinValidMm = 20;  // below: error codes, never ranges
+constexpr float kUrgRangeMinM = 0.02F;
+constexpr float kUrgRangeMaxM = 5.6F;
+
+// DP-SLAM sample logs carry no time: one scan per 100 ms is synthesised.
+constexpr std::int64_t kDpSlamPeriodUs = 100000;
+
+// Reads lines through gzread. Lines longer than kMaxLineBytes are cut off and flagged
+// (the rest of such a line is discarded up to its newline).
+class LineSource {
+ public:
+  ~LineSource() { close(); }
+
+  bool open(const std::string& path, std::string* error) {
+    file_ = gzopen(path.c_str(), "rb");
+    if (file_ == nullptr) {
+      *error = path + ": cannot open: " + (errno != 0 ? std::strerror(errno) : "out of memory");
+      return false;
+    }
+    gzbuffer(file_, 256U * 1024U);
+    buf_.resize(256U * 1024U);
+    return true;
+  }
+
+  void close() {
+    if (file_ != nullptr) gzclose(file_);
+    file_ = nullptr;
+  }
+
+  // False at the end of input. *overlong is set for a line longer than kMaxLineBytes (its
+  // first kMaxLineBytes bytes are in *line). A read error ends the input with *read_error.
+  bool next(std::string* line, bool* overlong) {
+    line->clear();
+    *overlong = false;
+    bool any = false;
+    for (;;) {
+      if (pos_ == len_) {
+        if (!fill()) return any;
+      }
+      const char* start = buf_.data() + pos_;
+      const std::size_t avail = len_ - pos_;
+      const void* nl = std::memchr(start, '\n', avail);
+      const std::size_t take = nl != nullptr ? static_cast<std::size_t>(static_cast<const char*>(nl) - start) : avail;
+      any = true;
+      if (!*overlong) {
+        const std::size_t room = detail::kMaxLineBytes + 1 - line->size();
+        if (take < room) {
+          line->append(start, take);
+        } else {
+          line->append(start, room - 1);
+          *overlong = true;
+        }
+      }
+      pos_ += take;
+      if (nl != nullptr) {
+        ++pos_;
+        break;
+      }
+    }
+    if (!line->empty() && line->back() == '\r') line->pop_back();
+    return true;
+  }
+
+  const std::string& read_error() const { return read_error_; }
+  std::uint64_t offset() const {
+    if (file_ == nullptr) return 0;
+    const z_off_t off = gzoffset(file_);
+    return off > 0 ? static_cast<std::uint64_t>(off) : 0U;
+  }
+
+ private:
+  bool fill() {
+    if (file_ == nullptr || eof_) return false;
+    const int got = gzread(file_, buf_.data(), static_cast<unsigned>(buf_.size()));
+    if (got <= 0) {
+      eof_ = true;
+      int errnum = Z_OK;
+      const char* msg = gzerror(file_, &errnum);
+      if (got < 0 || (errnum != Z_OK && errnum != Z_STREAM_END)) {
+        read_error_ = errnum == Z_BUF_ERROR ? "compressed input ends early (truncated .gz)"
+                                            : std::string("read error: ") + (msg != nullptr ? msg : "unknown");
+      }
+      return false;
+    }
+    pos_ = 0;
+    len_ = static_cast<std::size_t>(got);
+    return true;
+  }
+
+  gzFile file_ = nullptr;
+  std::vector<char> buf_;
+  std::size_t pos_ = 0;
+  std::size_t len_ = 0;
+  bool eof_ = false;
+  std::string read_error_;
+};
+
+bool is_carmen_keyword(std::string_view k) {
+  static constexpr const char* kKnown[] = {"PARAM",     "ODOM",      "FLASER",    "RLASER",    "ROBOTLASER1",
+                                           "ROBOTLASER2", "SYNC",    "TRUEPOS",   "RAWLASER1", "RAWLASER2",
+                                           "RAWLASER3", "RAWLASER4", "SONAR",     "BUMPER",    "SCANMARK",
+                                           "POSITIONLASER", "IMU",   "GPSNMEA"};
+  for (const char* name : kKnown) {
+    if (k == name) return true;
+  }
+  return k.rfind("NMEA-", 0) == 0;
+}
+
+// The format a line belongs to, or kAuto when it tells nothing.
+LogFormat classify_line(const std::vector<std::string_view>& f) {
+  if (f.empty() || f[0][0] == '#') return LogFormat::kAuto;
+  if (is_carmen_keyword(f[0])) return LogFormat::kCarmen;
+  if (f[0] == "Odometry" || f[0] == "Laser") return LogFormat::kDpSlam;
+  std::int64_t v = 0;
+  if (f.size() >= kTinyFirstRangeField + kTinyBeams && detail::parse_int(f[0], &v)) return LogFormat::kTinySlam;
+  return LogFormat::kAuto;
+}
+
+}  // namespace
+
+struct LogReader::Impl {
+  LogReaderOptions options;
+  std::string path;
+  LineSource source;
+  LogFormat format = LogFormat::kAuto;
+  std::string line;
+  std::vector<std::string_view> fields;
+  std::string reason;
+  std::int64_t line_no = 0;
+  std::vector<LogError> errors;
+  std::size_t error_count = 0;
+  std::size_t warning_count = 0;
+  bool read_error_reported = false;
+
+  LaserRecord laser;
+  OdomRecord odom;
+  ParamRecord param;
+
+  // tinySLAM odometry integration state.
+  bool ticks_latched = false;
+  std::int64_t last_left_ticks = 0;
+  std::int64_t last_right_ticks = 0;
+  Pose2 wheel_pose;
+
+  // DP-SLAM state.
+  std::int64_t dp_scan_index = 0;
+  bool dp_have_odom = false;
+  Pose2 dp_odom;
+
+  void add_error(std::int64_t at_line, std::string why, bool warning) {
+    ++error_count;
+    if (warning) ++warning_count;
+    if (errors.size() < options.max_errors_kept) errors.push_back(LogError{path, at_line, std::move(why), warning});
+  }
+
+  void apply_param(const ParamRecord& p) {
+    // Only well-formed numbers are taken; anything else leaves the option as it was.
+    double v = 0.0;
+    if (!detail::parse_finite(p.value, &v)) return;
+    if (p.name == "robot_frontlaser_offset") options.front_laser_offset_m = v;
+    if (p.name == "robot_rearlaser_offset") options.rear_laser_offset_m = v;
+    if (v > 0.0 && (p.name == "robot_frontlaser_max" || p.name == "robot_front_laser_max")) {
+      options.front_laser_max_m = static_cast<float>(v);
+    }
+    if (v > 0.0 && (p.name == "robot_rearlaser_max" || p.name == "robot_rear_laser_max")) {
+      options.rear_laser_max_m = static_cast<float>(v);
+    }
+  }
+
+  Next parse_tinyslam() {
+    const std::size_t want = kTinyFirstRangeField + kTinyBeams;
+    // The published file has one more field after the ranges, which BreezySLAM drops.
+    if (fields.size() != want && fields.size() != want + 1) {
+      reason = "tinySLAM line needs " + std::to_string(want) + " or " + std::to_string(want + 1) +
+               " fields, found " + std::to_string(fields.size());
+      return Next::kEnd;
+    }
+    std::int64_t stamp_us = 0;
+    std::int64_t left = 0;
+    std::int64_t right = 0;
+    if (!detail::parse_int(fields[kTinyStampField], &stamp_us)) {
+      reason = "timestamp (field 1) is not an integer: " + detail::quote(fields[kTinyStampField]);
+      return Next::kEnd;
+    }
+    if (!detail::parse_int(fields[kTinyLeftTicksField], &left) ||
+        !detail::parse_int(fields[kTinyRightTicksField], &right)) {
+      reason = "wheel ticks (fields 3, 4) are not integers";
+      return Next::kEnd;
+    }
+    RangeScan& scan = laser.scan;
+    for (std::uint32_t b = 0; b < kTinyBeams; ++b) {
+      const std::size_t i = kTinyFirstRangeField + b;
+      std::int64_t mm = 0;
+      if (!detail::parse_int(fields[i], &mm) || mm < 0 || mm > 1000000) {
+        reason = "range " + std::to_string(b) + " (field " + std::to_string(i + 1) +
+                 ") is not a millimetre count: " + detail::quote(fields[i]);
+        return Next::kEnd;
+      }
+      scan.ranges_m[b] = mm < kUrgMinValidMm ? 0.0F : static_cast<float>(mm) / 1000.0F;
+    }
+    scan.beam_count = kTinyBeams;
+    scan.geometry.angle_min_rad =
+        static_cast<float>(static_cast<double>(kUrgFirstStep - kUrgFrontStep) * 2.0 * kPi / kUrgStepsPerRev);
+    scan.geometry.angle_increment_rad = static_cast<float>(2.0 * kPi / kUrgStepsPerRev);
+    scan.geometry.range_min_m = kUrgRangeMinM;
+    scan.geometry.range_max_m = kUrgRangeMaxM;
+    scan.geometry.laser_in_base = Pose2{options.tinyslam_laser_offset_m, 0.0, 0.0};
+    scan.stamp_us = stamp_us;
+
+    // Differential drive, integrated along the arc (protocols.md section 4); the first
+    // sample is latched, never integrated.
+    if (!ticks_latched) {
+      ticks_latched = true;
+      wheel_pose = Pose2{};
+    } else {
+      const WheelOdometryParams& w = options.wheels;
+      const double rad_per_tick = 2.0 * kPi / w.ticks_per_rev;
+      const double dl_m = static_cast<double>(left - last_left_ticks) * rad_per_tick * w.wheel_radius_m;
+      const double dr_m = static_cast<double>(right - last_right_ticks) * rad_per_tick * w.wheel_radius_m;
+      const double ds = (dl_m + dr_m) / 2.0;
+      const double dth = (dr_m - dl_m) / w.wheel_separation_m;
+      const double th = wheel_pose.heading_rad;
+      if (std::fabs(dth) < 1e-6) {
+        wheel_pose.x_m += ds * std::cos(th);
+        wheel_pose.y_m += ds * std::sin(th);
+      } else {
+        wheel_pose.x_m += ds / dth * (std::sin(th + dth) - std::sin(th));
+        wheel_pose.y_m -= ds / dth * (std::cos(th + dth) - std::cos(th));
+      }
+      wheel_pose.heading_rad = normalize_angle_rad(th + dth);
+    }
+    last_left_ticks = left;
+    last_right_ticks = right;
+
+    laser.keyword = "tinyslam";
+    laser.stamp_us = stamp_us;
+    laser.logger_stamp_us = 0;
+    laser.has_stamp = true;
+    laser.has_laser_pose = false;
+    laser.laser_pose = Pose2{};
+    laser.odom_pose = wheel_pose;
+    laser.has_odom_pose = true;
+    return Next::kLaser;
+  }
+
+  Next parse_dpslam() {
+    const std::string_view k = fields[0];
+    if (k == "Odometry") {
+      if (fields.size() != 4) {
+        reason = "Odometry needs 4 fields, found " + std::to_string(fields.size());
+        return Next::kEnd;
+      }
+      double v[3];
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (!detail::parse_finite(fields[i + 1], &v[i])) {
+          reason = "Odometry field " + std::to_string(i + 2) + " is not a finite number: " +
+                   detail::quote(fields[i + 1]);
+          return Next::kEnd;
+        }
+      }
+      dp_odom = Pose2{v[0], v[1], v[2]};
+      dp_have_odom = true;
+      odom = OdomRecord{};
+      odom.pose = dp_odom;
+      odom.stamp_us = dp_scan_index * kDpSlamPeriodUs;  // the stamp the next scan gets
+      return Next::kOdom;
+    }
+    if (k != "Laser") {
+      reason = "expected 'Odometry' or 'Laser', found " + detail::quote(k);
+      return Next::kEnd;
+    }
+    std::int64_t n = 0;
+    if (fields.size() < 2 || !detail::parse_int(fields[1], &n)) {
+      reason = "Laser beam count (field 2) is missing or not an integer";
+      return Next::kEnd;
+    }
+    if (n < 2 || n > static_cast<std::int64_t>(capacity::kMaxBeams)) {
+      reason = "Laser beam count " + std::to_string(n) + " is outside [2, " + std::to_string(capacity::kMaxBeams) + "]";
+      return Next::kEnd;
+    }
+    if (fields.size() != static_cast<std::size_t>(n) + 2U) {
+      reason = "Laser with " + std::to_string(n) + " readings needs " + std::to_string(n + 2) + " fields, found " +
+               std::to_string(fields.size());
+      return Next::kEnd;
+    }
+    RangeScan& scan = laser.scan;
+    for (std::int64_t b = 0; b < n; ++b) {
+      const std::size_t i = 2U + static_cast<std::size_t>(b);
+      float r = 0.0F;
+      if (!detail::parse_finite(fields[i], &r) || r < 0.0F) {
+        reason = "range " + std::to_string(b) + " (field " + std::to_string(i + 1) +
+                 ") is not a finite non-negative number: " + detail::quote(fields[i]);
+        return Next::kEnd;
+      }
+      scan.ranges_m[b] = r;
+    }
+    scan.beam_count = static_cast<std::uint32_t>(n);
+    scan.geometry.angle_min_rad = static_cast<float>(-kPi / 2.0);
+    scan.geometry.angle_increment_rad = static_cast<float>(kPi / static_cast<double>(n - 1));
+    scan.geometry.range_min_m = 0.0F;
+    scan.geometry.range_max_m = options.default_range_max_m;
+    scan.geometry.laser_in_base = Pose2{};
+    laser.keyword = "dpslam";
+    laser.stamp_us = dp_scan_index * kDpSlamPeriodUs;
+    scan.stamp_us = laser.stamp_us;
+    laser.logger_stamp_us = 0;
+    laser.has_stamp = false;
+    laser.has_laser_pose = false;
+    laser.laser_pose = Pose2{};
+    laser.odom_pose = dp_odom;
+    laser.has_odom_pose = dp_have_odom;
+    ++dp_scan_index;
+    return Next::kLaser;
+  }
+};
+
+LogReader::LogReader() : impl_(std::make_unique<Impl>()) {}
+LogReader::~LogReader() = default;
+
+bool LogReader::open(const std::string& path, const LogReaderOptions& options, std::string* error) {
+  impl_ = std::make_unique<Impl>();
+  impl_->options = options;
+  impl_->path = path;
+  std::string local_error;
+  std::string* err = error != nullptr ? error : &local_error;
+  LogFormat format = options.format;
+  if (format == LogFormat::kAuto) {
+    // A first pass over the head of the file; the first line that names a format decides.
+    constexpr int kDetectLines = 100;
+    LineSource probe;
+    if (!probe.open(path, err)) return false;
+    std::string line;
+    bool overlong = false;
+    std::vector<std::string_view> fields;
+    for (int i = 0; i < kDetectLines && format == LogFormat::kAuto && probe.next(&line, &overlong); ++i) {
+      if (overlong || !detail::check_text(line).empty()) continue;
+      detail::split_fields(line, &fields);
+      format = classify_line(fields);
+    }
+    if (format == LogFormat::kAuto) {
+      *err = path + ": cannot detect the log format from its first " + std::to_string(kDetectLines) +
+             " lines (expected CARMEN keywords, 'Odometry'/'Laser' lines, or tinySLAM numeric lines)" +
+             (probe.read_error().empty() ? "" : "; " + probe.read_error());
+      return false;
+    }
+  }
+  if (!impl_->source.open(path, err)) return false;
+  impl_->format = format;
+  return true;
+}
+
+LogReader::Next LogReader::next() {
+  Impl& s = *impl_;
+  if (s.format == LogFormat::kAuto) return Next::kEnd;  // not open
+  bool overlong = false;
+  while (s.source.next(&s.line, &overlong)) {
+    ++s.line_no;
+    if (overlong) {
+      s.add_error(s.line_no, "line longer than " + std::to_string(detail::kMaxLineBytes) + " bytes", false);
+      continue;
+    }
+    std::string bad = detail::check_text(s.line);
+    if (!bad.empty()) {
+      s.add_error(s.line_no, bad, false);
+      continue;
+    }
+    detail::split_fields(s.line, &s.fields);
+    if (s.fields.empty() || s.fields[0][0] == '#') continue;
+    s.reason.clear();
+    Next got = Next::kEnd;
+    switch (s.format) {
+      case LogFormat::kCarmen:
+        got = detail::parse_carmen_fields(s.fields, s.options, &s.laser, &s.odom, &s.param, &s.reason);
+        break;
+      case LogFormat::kTinySlam: got = s.parse_tinyslam(); break;
+      case LogFormat::kDpSlam: got = s.parse_dpslam(); break;
+      case LogFormat::kAuto: break;
+    }
+    if (!s.reason.empty()) {
+      const bool warning = s.reason.rfind(detail::kUnknownTypePrefix, 0) == 0;
+      s.add_error(s.line_no, s.reason, warning);
+      continue;
+    }
+    if (got == Next::kEnd) continue;  // an ignored message type
+    switch (got) {
+      case Next::kLaser: s.laser.line = s.line_no; break;
+      case Next::kOdom: s.odom.line = s.line_no; break;
+      case Next::kParam:
+        s.param.line = s.line_no;
+        s.apply_param(s.param);
+        break;
+      case Next::kEnd: break;
+    }
+    return got;
+  }
+  if (!s.source.read_error().empty() && !s.read_error_reported) {
+    s.read_error_reported = true;
+    s.add_error(s.line_no + 1, s.source.read_error(), false);
+  }
+  return Next::kEnd;
+}
+
+const LaserRecord& LogReader::laser() const { return impl_->laser; }
+const OdomRecord& LogReader::odom() const { return impl_->odom; }
+const ParamRecord& LogReader::param() const { return impl_->param; }
+LogFormat LogReader::format() const { return impl_->format; }
+const std::vector<LogError>& LogReader::errors() const { return impl_->errors; }
+std::size_t LogReader::error_count() const { return impl_->error_count; }
+std::size_t LogReader::warning_count() const { return impl_->warning_count; }
+std::int64_t LogReader::lines_read() const { return impl_->line_no; }
+std::uint64_t LogReader::input_offset() const { return impl_->source.offset(); }
+
+bool read_whole_log(const std::string& path, const LogReaderOptions& options, LogContents* out, std::string* error) {
+  *out = LogContents{};
+  LogReader reader;
+  if (!reader.open(path, options, error)) return false;
+  for (;;) {
+    const LogReader::Next n = reader.next();
+    if (n == LogReader::Next::kEnd) break;
+    switch (n) {
+      case LogReader::Next::kLaser: out->lasers.push_back(reader.laser()); break;
+      case LogReader::Next::kOdom: out->odoms.push_back(reader.odom()); break;
+      case LogReader::Next::kParam: out->params.push_back(reader.param()); break;
+      case LogReader::Next::kEnd: break;
+    }
+  }
+  out->errors = reader.errors();
+  out->error_count = reader.error_count();
+  out->warning_count = reader.warning_count();
+  out->format = reader.format();
+  return true;
+}
+
+}  // namespace sdpslam::io
