@@ -228,6 +228,7 @@ class AncestryTree {
   NodeId first_root_ = kNoNode;
   NodeId last_root_ = kNoNode;
   std::uint32_t active_count_ = 0U;
+  std::uint32_t label_counter_ = 0U;  // next free DFS number (new roots take fresh ones)
   std::uint32_t node_oom_count_ = 0U;
   std::uint32_t path_oom_count_ = 0U;
   std::uint32_t misuse_count_ = 0U;

@@ -1,0 +1,340 @@
+// Distributed particle map: tiled grid of per-cell observation lists (paper §II-A).
+#include "sdpslam/core/dp_map.h"
+
+#include <cmath>
+
+namespace sdpslam {
+
+namespace {
+
+struct GridDims {
+  std::int32_t width_cells = 0;
+  std::int32_t height_cells = 0;
+  std::uint32_t tiles_x = 0U;
+  std::uint32_t tiles_y = 0U;
+};
+
+// Whole cells covering `extent_m`; a relative tolerance keeps 10 m / 0.05 m at 200 cells
+// despite the quotient's rounding error. 0 iff out of range.
+std::int32_t cells_for(double extent_m, double resolution_m) {
+  const double q = extent_m / resolution_m;
+  if (!(q > 0.0) || !std::isfinite(q) || q >= 2147483000.0) return 0;
+  return static_cast<std::int32_t>(std::ceil(q - 1e-9 * q));
+}
+
+bool grid_dims(const DpMap::Options& o, GridDims* d) {
+  if (!std::isfinite(o.origin_x_m) || !std::isfinite(o.origin_y_m)) return false;
+  if (!(o.resolution_m > 0.0) || !(o.width_m > 0.0) || !(o.height_m > 0.0)) return false;
+  if (o.tile_capacity == 0U || o.tile_capacity > capacity::kDpMaxTiles || o.observation_capacity == 0U) return false;
+  if (o.observation_capacity >= 0xFFFFFFF0U) return false;
+  d->width_cells = cells_for(o.width_m, o.resolution_m);
+  d->height_cells = cells_for(o.height_m, o.resolution_m);
+  if (d->width_cells <= 0 || d->height_cells <= 0) return false;
+  const std::uint32_t side = capacity::kDpTileSideCells;
+  d->tiles_x = (static_cast<std::uint32_t>(d->width_cells) + side - 1U) / side;
+  d->tiles_y = (static_cast<std::uint32_t>(d->height_cells) + side - 1U) / side;
+  return static_cast<std::uint64_t>(d->tiles_x) * d->tiles_y < 0xFFFFFFFFULL;
+}
+
+template <typename T>
+std::size_t pool_bytes(std::uint32_t capacity) {
+  return PoolOf<T>::kSlotSize * capacity + 2U * sizeof(std::uint32_t) * capacity + alignof(T) +
+         2U * alignof(std::uint32_t);
+}
+
+}  // namespace
+
+bool DpMap::options_valid(const Options& options) {
+  GridDims d;
+  return grid_dims(options, &d);
+}
+
+std::size_t DpMap::required_arena_bytes(const Options& options, std::uint32_t node_capacity) {
+  GridDims d;
+  if (!grid_dims(options, &d)) return 0U;
+  return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + node_capacity) +
+         2U * alignof(std::uint32_t) + pool_bytes<Tile>(options.tile_capacity) +
+         pool_bytes<Observation>(options.observation_capacity);
+}
+
+bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree) {
+  tree_ = nullptr;
+  GridDims d;
+  if (!grid_dims(options, &d) || tree.capacity() == 0U) return false;
+  const std::size_t table_entries = static_cast<std::size_t>(d.tiles_x) * d.tiles_y;
+  tile_table_ = arena.allocate_array<std::uint32_t>(table_entries);
+  node_head_ = arena.allocate_array<std::uint32_t>(tree.capacity());
+  if (tile_table_ == nullptr || node_head_ == nullptr) return false;
+  if (!tiles_pool_.init(arena, options.tile_capacity) || !obs_pool_.init(arena, options.observation_capacity)) {
+    return false;
+  }
+  for (std::size_t i = 0; i < table_entries; ++i) tile_table_[i] = kNone;
+  for (std::uint32_t i = 0; i < tree.capacity(); ++i) node_head_[i] = kNone;
+  options_ = options;
+  width_cells_ = d.width_cells;
+  height_cells_ = d.height_cells;
+  tiles_x_ = d.tiles_x;
+  tiles_y_ = d.tiles_y;
+  node_capacity_ = tree.capacity();
+  tiles_ = nullptr;
+  obs_ = nullptr;
+  tree_ = &tree;
+  return true;
+}
+
+bool DpMap::world_to_cell(double x_m, double y_m, std::int32_t* ix, std::int32_t* iy) const {
+  if (tree_ == nullptr) return false;
+  const double fx = std::floor((x_m - options_.origin_x_m) / options_.resolution_m);
+  const double fy = std::floor((y_m - options_.origin_y_m) / options_.resolution_m);
+  // The negated comparisons also reject NaN.
+  if (!(fx >= 0.0 && fx < static_cast<double>(width_cells_) && fy >= 0.0 && fy < static_cast<double>(height_cells_))) {
+    return false;
+  }
+  *ix = static_cast<std::int32_t>(fx);
+  *iy = static_cast<std::int32_t>(fy);
+  return true;
+}
+
+void DpMap::cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y_m) const {
+  *x_m = options_.origin_x_m + (static_cast<double>(ix) + 0.5) * options_.resolution_m;
+  *y_m = options_.origin_y_m + (static_cast<double>(iy) + 0.5) * options_.resolution_m;
+}
+
+std::uint32_t DpMap::find_in_cell(std::uint32_t first, NodeId node) const {
+  for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
+    if (obs_[e].node == node) return e;
+  }
+  return kNone;
+}
+
+bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation value) {
+  if (tree_ == nullptr || !tree_->contains(particle)) {
+    ++misuse_count_;
+    return false;
+  }
+  if (!in_bounds(ix, iy)) {
+    ++out_of_bounds_count_;
+    return false;
+  }
+  const std::uint32_t ti = tile_index(ix, iy);
+  const std::uint32_t c = cell_in_tile(ix, iy);
+  std::uint32_t slot = tile_table_[ti];
+  if (slot != kNone) {
+    const std::uint32_t e = find_in_cell(tiles_[slot].head[c], particle);
+    if (e != kNone) {
+      obs_[e].value = value;
+      return true;
+    }
+  }
+  // A new entry is needed. Check the observation pool first so that a refused update
+  // never allocates (and then has to release) a tile.
+  if (obs_pool_.full()) {
+    ++observation_oom_count_;
+    return false;
+  }
+  if (slot == kNone) {
+    Tile* t = static_cast<Tile*>(tiles_pool_.allocate());
+    if (t == nullptr) {
+      ++tile_oom_count_;
+      return false;
+    }
+    slot = tiles_pool_.index_of(t);
+    tiles_ = t - slot;  // pool slots are contiguous: slot 0 is the base used by lookups
+    for (std::uint32_t i = 0; i < capacity::kDpTileCells; ++i) t->head[i] = kNone;
+    t->count = 0U;
+    t->table_index = ti;
+    tile_table_[ti] = slot;
+    const std::uint32_t tx = ti % tiles_x_;
+    const std::uint32_t ty = ti / tiles_x_;
+    if (touched_tx0_ == kNone) {
+      touched_tx0_ = touched_tx1_ = tx;
+      touched_ty0_ = touched_ty1_ = ty;
+    } else {
+      if (tx < touched_tx0_) touched_tx0_ = tx;
+      if (tx > touched_tx1_) touched_tx1_ = tx;
+      if (ty < touched_ty0_) touched_ty0_ = ty;
+      if (ty > touched_ty1_) touched_ty1_ = ty;
+    }
+  }
+  Observation* o = static_cast<Observation*>(obs_pool_.allocate());  // cannot fail: checked above
+  const std::uint32_t e = obs_pool_.index_of(o);
+  obs_ = o - e;
+  Tile& tile = tiles_[slot];
+  o->node = particle;
+  o->value = value;
+  o->location = (slot << (2U * kSideLog2)) | c;
+  o->next_in_cell = tile.head[c];
+  tile.head[c] = e;
+  o->next_in_node = node_head_[particle];
+  node_head_[particle] = e;
+  ++tile.count;
+  return true;
+}
+
+bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
+  CellObservation view;
+  if (!lookup(particle, ix, iy, &view)) view = CellObservation{};
+  return update(particle, ix, iy, accumulate(view, hits, misses));
+}
+
+void DpMap::unlink_from_cell(std::uint32_t e) {
+  const std::uint32_t loc = obs_[e].location;
+  Tile& tile = tiles_[loc >> (2U * kSideLog2)];
+  std::uint32_t* link = &tile.head[loc & (capacity::kDpTileCells - 1U)];
+  while (*link != kNone && *link != e) link = &obs_[*link].next_in_cell;
+  if (*link == e) *link = obs_[e].next_in_cell;
+}
+
+void DpMap::release_observation(std::uint32_t e) {
+  unlink_from_cell(e);
+  const std::uint32_t slot = obs_[e].location >> (2U * kSideLog2);
+  Tile& tile = tiles_[slot];
+  if (--tile.count == 0U) {  // last observation gone: the tile returns to the pool
+    tile_table_[tile.table_index] = kNone;
+    tiles_pool_.release(&tile);
+  }
+  obs_pool_.release(&obs_[e]);
+}
+
+void DpMap::on_node_removed(NodeId node) {
+  if (tree_ == nullptr || node >= node_capacity_) {
+    ++misuse_count_;
+    return;
+  }
+  std::uint32_t e = node_head_[node];
+  while (e != kNone) {
+    const std::uint32_t next = obs_[e].next_in_node;
+    release_observation(e);
+    e = next;
+  }
+  node_head_[node] = kNone;
+}
+
+void DpMap::on_node_merged(NodeId parent, NodeId child) {
+  if (tree_ == nullptr || parent >= node_capacity_ || child >= node_capacity_ || parent == child) {
+    ++misuse_count_;
+    return;
+  }
+  std::uint32_t e = node_head_[parent];
+  while (e != kNone) {
+    Observation& o = obs_[e];
+    const std::uint32_t next = o.next_in_node;
+    const std::uint32_t loc = o.location;
+    const std::uint32_t head = tiles_[loc >> (2U * kSideLog2)].head[loc & (capacity::kDpTileCells - 1U)];
+    if (find_in_cell(head, child) != kNone) {
+      release_observation(e);  // the child's own record is newer and shadows it
+    } else {
+      o.node = child;
+      o.next_in_node = node_head_[child];
+      node_head_[child] = e;
+    }
+    e = next;
+  }
+  node_head_[parent] = kNone;
+}
+
+void DpMap::location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const {
+  const Tile& tile = tiles_[location >> (2U * kSideLog2)];
+  const std::uint32_t c = location & (capacity::kDpTileCells - 1U);
+  *ix = static_cast<std::int32_t>(((tile.table_index % tiles_x_) << kSideLog2) | (c & kSideMask));
+  *iy = static_cast<std::int32_t>(((tile.table_index / tiles_x_) << kSideLog2) | (c >> kSideLog2));
+}
+
+std::uint32_t DpMap::fill_rect(NodeId particle, const CellRect& rect, CellObservation* values,
+                               std::uint8_t* known) const {
+  std::uint32_t known_count = 0U;
+  std::size_t i = 0U;
+  for (std::uint32_t r = 0U; r < rect.height; ++r) {
+    const std::int64_t iy64 = static_cast<std::int64_t>(rect.iy0) + r;
+    for (std::uint32_t col = 0U; col < rect.width; ++col, ++i) {
+      const std::int64_t ix64 = static_cast<std::int64_t>(rect.ix0) + col;
+      bool ok = false;
+      if (tree_ != nullptr && ix64 >= 0 && iy64 >= 0 && ix64 < width_cells_ && iy64 < height_cells_) {
+        ok = lookup(particle, static_cast<std::int32_t>(ix64), static_cast<std::int32_t>(iy64), &values[i]);
+      }
+      known[i] = ok ? 1U : 0U;
+      if (ok) ++known_count;
+    }
+  }
+  return known_count;
+}
+
+bool DpMap::touched_bounds(CellRect* out) const {
+  if (touched_tx0_ == kNone) return false;
+  const std::uint32_t x0 = touched_tx0_ << kSideLog2;
+  const std::uint32_t y0 = touched_ty0_ << kSideLog2;
+  std::uint32_t x1 = (touched_tx1_ + 1U) << kSideLog2;
+  std::uint32_t y1 = (touched_ty1_ + 1U) << kSideLog2;
+  if (x1 > static_cast<std::uint32_t>(width_cells_)) x1 = static_cast<std::uint32_t>(width_cells_);
+  if (y1 > static_cast<std::uint32_t>(height_cells_)) y1 = static_cast<std::uint32_t>(height_cells_);
+  out->ix0 = static_cast<std::int32_t>(x0);
+  out->iy0 = static_cast<std::int32_t>(y0);
+  out->width = x1 - x0;
+  out->height = y1 - y0;
+  return true;
+}
+
+std::uint32_t DpMap::entries_in_cell(std::int32_t ix, std::int32_t iy) const {
+  if (tree_ == nullptr || !in_bounds(ix, iy)) return 0U;
+  const std::uint32_t slot = tile_table_[tile_index(ix, iy)];
+  if (slot == kNone) return 0U;
+  std::uint32_t n = 0U;
+  for (std::uint32_t e = tiles_[slot].head[cell_in_tile(ix, iy)]; e != kNone; e = obs_[e].next_in_cell) ++n;
+  return n;
+}
+
+std::uint32_t DpMap::observation_count(NodeId node) const {
+  if (tree_ == nullptr || node >= node_capacity_) return 0U;
+  std::uint32_t n = 0U;
+  for (std::uint32_t e = node_head_[node]; e != kNone; e = obs_[e].next_in_node) ++n;
+  return n;
+}
+
+std::size_t DpMap::footprint_bytes() const {
+  return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + node_capacity_) +
+         tiles_pool_.footprint_bytes() + obs_pool_.footprint_bytes();
+}
+
+bool DpMap::invariants_hold() const {
+  if (tree_ == nullptr) return true;
+  if (!tiles_pool_.invariants_hold() || !obs_pool_.invariants_hold()) return false;
+  const std::uint32_t obs_total = obs_pool_.size();
+  // Cells: each tile in use is referenced once, knows its table entry, counts its
+  // entries, is not empty; each entry is live, addresses this cell, belongs to a live
+  // tree node, and no node appears twice in one cell.
+  std::uint32_t tiles_seen = 0U;
+  std::uint32_t in_cells = 0U;
+  for (std::uint32_t t = 0U; t < tiles_x_ * tiles_y_; ++t) {
+    const std::uint32_t slot = tile_table_[t];
+    if (slot == kNone) continue;
+    if (!tiles_pool_.slot_in_use(slot) || tiles_ == nullptr) return false;
+    ++tiles_seen;
+    const Tile& tile = tiles_[slot];
+    if (tile.table_index != t || tile.count == 0U) return false;
+    std::uint32_t in_tile = 0U;
+    for (std::uint32_t c = 0U; c < capacity::kDpTileCells; ++c) {
+      for (std::uint32_t e = tile.head[c]; e != kNone; e = obs_[e].next_in_cell) {
+        if (!obs_pool_.slot_in_use(e) || ++in_cells > obs_total) return false;
+        ++in_tile;
+        const Observation& o = obs_[e];
+        if (o.location != ((slot << (2U * kSideLog2)) | c) || !tree_->contains(o.node)) return false;
+        for (std::uint32_t f = o.next_in_cell; f != kNone; f = obs_[f].next_in_cell) {
+          if (obs_[f].node == o.node) return false;
+        }
+      }
+    }
+    if (in_tile != tile.count) return false;
+  }
+  if (tiles_seen != tiles_pool_.size() || in_cells != obs_total) return false;
+  // Nodes: each list holds only that node's entries; lists add up to the pool count.
+  std::uint32_t in_nodes = 0U;
+  for (NodeId n = 0U; n < node_capacity_; ++n) {
+    if (node_head_[n] != kNone && !tree_->contains(n)) return false;
+    for (std::uint32_t e = node_head_[n]; e != kNone; e = obs_[e].next_in_node) {
+      if (!obs_pool_.slot_in_use(e) || ++in_nodes > obs_total || obs_[e].node != n) return false;
+    }
+  }
+  return in_nodes == obs_total;
+}
+
+}  // namespace sdpslam

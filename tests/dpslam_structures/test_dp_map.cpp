@@ -1,0 +1,273 @@
+// Distributed particle map (paper §II-A): geometry, views through the ancestry tree,
+// merge/remove hooks, exhaustion and misuse, extraction.
+#include <CppUTest/TestHarness.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "dp_fixture.h"
+#include "sdpslam/core/dp_map.h"
+
+using sdpslam::CellObservation;
+using sdpslam::DpMap;
+using sdpslam::kNoNode;
+using sdpslam::NodeId;
+using sdpslam::test::DpFixture;
+using sdpslam::test::small_options;
+
+namespace {
+CellObservation obs(std::uint16_t h, std::uint16_t m) { return CellObservation{h, m}; }
+bool view_is(const DpMap& map, NodeId p, std::int32_t ix, std::int32_t iy, CellObservation expect) {
+  CellObservation v;
+  return map.lookup(p, ix, iy, &v) && v == expect;
+}
+}  // namespace
+
+TEST_GROUP(DpMap){};
+
+TEST(DpMap, invalid_options_are_refused) {
+  DpMap::Options o = small_options(4U, 4U);
+  CHECK_TRUE(DpMap::options_valid(o));
+  o.resolution_m = 0.0;
+  CHECK_FALSE(DpMap::options_valid(o));
+  LONGS_EQUAL(0U, DpMap::required_arena_bytes(o, 8U));
+  o = small_options(0U, 4U);
+  CHECK_FALSE(DpMap::options_valid(o));
+  o = small_options(4U, 0U);
+  CHECK_FALSE(DpMap::options_valid(o));
+  o = small_options(4U, 4U);
+  o.width_m = -1.0;
+  CHECK_FALSE(DpMap::options_valid(o));
+  o = small_options(4U, 4U);
+  o.origin_x_m = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(DpMap::options_valid(o));
+  o = small_options(4U, 4U);
+  o.width_m = 1e9;  // 2e10 cells per axis
+  CHECK_FALSE(DpMap::options_valid(o));
+}
+
+TEST(DpMap, init_refuses_a_too_small_arena_and_then_refuses_updates) {
+  std::vector<unsigned char> buf(sdpslam::AncestryTree::required_arena_bytes(8U, 8U) + 100U);
+  sdpslam::Arena arena(buf.data(), buf.size());
+  sdpslam::AncestryTree tree;
+  CHECK_TRUE(tree.init(arena, 8U, 8U));
+  DpMap map;
+  CHECK_FALSE(map.init(arena, small_options(4U, 64U), tree));
+  const NodeId r = tree.create_root();
+  CHECK_FALSE(map.update(r, 0, 0, obs(1, 0)));
+  CellObservation v;
+  CHECK_FALSE(map.lookup(r, 0, 0, &v));
+  CHECK_TRUE(map.invariants_hold());
+}
+
+TEST(DpMap, grid_covers_the_area_in_whole_cells) {
+  DpFixture f(8U, 8U, small_options(4U, 16U));
+  LONGS_EQUAL(48, f.map.width_cells());
+  LONGS_EQUAL(40, f.map.height_cells());
+}
+
+TEST(DpMap, world_to_cell_floors_and_rejects_outside_and_nan) {
+  DpFixture f(8U, 8U, small_options(4U, 16U));
+  std::int32_t ix = -7;
+  std::int32_t iy = -7;
+  CHECK_TRUE(f.map.world_to_cell(-1.0, 2.0, &ix, &iy));
+  LONGS_EQUAL(0, ix);
+  LONGS_EQUAL(0, iy);
+  CHECK_TRUE(f.map.world_to_cell(-0.951, 2.049, &ix, &iy));
+  LONGS_EQUAL(0, ix);
+  LONGS_EQUAL(0, iy);
+  CHECK_TRUE(f.map.world_to_cell(1.399, 3.999, &ix, &iy));
+  LONGS_EQUAL(47, ix);
+  LONGS_EQUAL(39, iy);
+  ix = iy = -7;
+  CHECK_FALSE(f.map.world_to_cell(-1.001, 2.5, &ix, &iy));
+  CHECK_FALSE(f.map.world_to_cell(1.401, 2.5, &ix, &iy));
+  CHECK_FALSE(f.map.world_to_cell(0.0, 4.001, &ix, &iy));
+  CHECK_FALSE(f.map.world_to_cell(std::nan(""), 2.5, &ix, &iy));
+  LONGS_EQUAL(-7, ix);  // outputs untouched on failure
+  double x = 0.0;
+  double y = 0.0;
+  f.map.cell_center(0, 39, &x, &y);
+  DOUBLES_EQUAL(-0.975, x, 1e-12);
+  DOUBLES_EQUAL(3.975, y, 1e-12);
+}
+
+TEST(DpMap, accumulate_adds_and_halves_both_counts_on_saturation) {
+  CHECK_TRUE(obs(3, 4) == sdpslam::accumulate(obs(1, 1), 2, 3));
+  const CellObservation s = sdpslam::accumulate(obs(65530, 100), 10, 1);
+  LONGS_EQUAL(32770, s.hits);  // 65540 / 2
+  LONGS_EQUAL(50, s.misses);   // 101 / 2
+  const CellObservation z = sdpslam::accumulate(obs(65535, 65535), 65535, 65535);
+  CHECK(z.hits < 65535 && z.misses < 65535);
+  CHECK_TRUE(z.hits == z.misses);
+}
+
+TEST(DpMap, a_child_sees_its_ancestors_observations_and_shadows_them) {
+  DpFixture f(16U, 8U, small_options(4U, 64U));
+  auto& t = f.tree;
+  auto& m = f.map;
+  const NodeId r = t.create_root();
+  CHECK_TRUE(m.update(r, 5, 5, obs(1, 0)));
+  const NodeId a = t.add_child(r);
+  const NodeId b = t.add_child(r);
+  CHECK_TRUE(view_is(m, a, 5, 5, obs(1, 0)));
+  CHECK_TRUE(m.update(a, 5, 5, obs(2, 0)));
+  CHECK_TRUE(view_is(m, a, 5, 5, obs(2, 0)));
+  CHECK_TRUE(view_is(m, b, 5, 5, obs(1, 0)));
+  CHECK_TRUE(view_is(m, r, 5, 5, obs(1, 0)));
+  const NodeId a1 = t.add_child(a);
+  CHECK_TRUE(view_is(m, a1, 5, 5, obs(2, 0)));  // nearest ancestor wins
+  CellObservation v;
+  CHECK_FALSE(m.lookup(a1, 6, 5, &v));
+  CHECK_TRUE(m.invariants_hold());
+}
+
+TEST(DpMap, update_in_place_uses_no_new_entry) {
+  DpFixture f(8U, 8U, small_options(4U, 2U));
+  const NodeId r = f.tree.create_root();
+  CHECK_TRUE(f.map.update(r, 1, 1, obs(1, 0)));
+  CHECK_TRUE(f.map.update(r, 1, 1, obs(5, 1)));
+  CHECK_TRUE(f.map.add(r, 1, 1, 1, 1));
+  LONGS_EQUAL(1, f.map.observations_used());
+  CHECK_TRUE(view_is(f.map, r, 1, 1, obs(6, 2)));
+}
+
+TEST(DpMap, add_starts_from_the_inherited_view) {
+  DpFixture f(8U, 8U, small_options(4U, 8U));
+  const NodeId r = f.tree.create_root();
+  CHECK_TRUE(f.map.add(r, 2, 3, 4, 1));
+  const NodeId c = f.tree.add_child(r);
+  CHECK_TRUE(f.map.add(c, 2, 3, 1, 0));
+  CHECK_TRUE(view_is(f.map, c, 2, 3, obs(5, 1)));
+  CHECK_TRUE(view_is(f.map, r, 2, 3, obs(4, 1)));
+}
+
+TEST(DpMap, removing_a_node_frees_its_observations_and_empty_tiles) {
+  DpFixture f(8U, 8U, small_options(9U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  const NodeId a = t.add_child(r);
+  const NodeId b = t.add_child(r);
+  CHECK_TRUE(f.map.update(a, 0, 0, obs(1, 0)));
+  CHECK_TRUE(f.map.update(a, 40, 30, obs(1, 0)));
+  CHECK_TRUE(f.map.update(b, 0, 0, obs(0, 1)));
+  LONGS_EQUAL(2, f.map.tiles_used());
+  t.set_active(a, false);
+  t.prune(&f.map);
+  CHECK_TRUE(f.map.invariants_hold());
+  LONGS_EQUAL(1, f.map.observations_used());
+  LONGS_EQUAL(1, f.map.tiles_used());
+  LONGS_EQUAL(2, f.map.tiles_peak());
+  CHECK_TRUE(view_is(f.map, b, 0, 0, obs(0, 1)));
+}
+
+TEST(DpMap, merge_relabels_to_the_child_except_where_the_child_is_newer) {
+  DpFixture f(8U, 8U, small_options(4U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  const NodeId p = t.add_child(r);
+  const NodeId q = t.add_child(r);
+  CHECK_TRUE(f.map.update(p, 1, 1, obs(1, 0)));
+  CHECK_TRUE(f.map.update(p, 2, 2, obs(2, 0)));
+  const NodeId c = t.add_child(p);
+  CHECK_TRUE(f.map.update(c, 2, 2, obs(9, 9)));
+  t.set_active(p, false);
+  t.prune(&f.map);  // p has one child: merged into c
+  CHECK_TRUE(f.map.invariants_hold());
+  CHECK_FALSE(t.contains(p));
+  LONGS_EQUAL(2, f.map.observation_count(c));
+  LONGS_EQUAL(2, f.map.observations_used());
+  LONGS_EQUAL(1, f.map.entries_in_cell(2, 2));
+  CHECK_TRUE(view_is(f.map, c, 1, 1, obs(1, 0)));
+  CHECK_TRUE(view_is(f.map, c, 2, 2, obs(9, 9)));
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(q, 1, 1, &v));
+}
+
+TEST(DpMap, observation_exhaustion_is_counted_and_leaves_views_unchanged) {
+  DpFixture f(8U, 8U, small_options(4U, 3U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  CHECK_TRUE(f.map.update(r, 0, 0, obs(1, 0)));
+  CHECK_TRUE(f.map.update(r, 1, 0, obs(2, 0)));
+  CHECK_TRUE(f.map.update(r, 2, 0, obs(3, 0)));
+  const NodeId c = t.add_child(r);
+  CHECK_FALSE(f.map.update(c, 0, 0, obs(7, 7)));
+  CHECK_FALSE(f.map.update(c, 3, 0, obs(7, 7)));
+  LONGS_EQUAL(2, f.map.observation_oom_count());
+  CHECK_TRUE(f.map.invariants_hold());
+  CHECK_TRUE(view_is(f.map, c, 0, 0, obs(1, 0)));  // still the inherited value
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(c, 3, 0, &v));
+  CHECK_TRUE(f.map.update(r, 2, 0, obs(4, 0)));  // in place still works
+  CHECK_TRUE(view_is(f.map, c, 2, 0, obs(4, 0)));
+}
+
+TEST(DpMap, tile_exhaustion_is_counted_and_existing_tiles_still_accept) {
+  DpFixture f(8U, 8U, small_options(1U, 64U));
+  const NodeId r = f.tree.create_root();
+  CHECK_TRUE(f.map.update(r, 0, 0, obs(1, 0)));
+  CHECK_FALSE(f.map.update(r, 16, 0, obs(1, 0)));  // next tile
+  LONGS_EQUAL(1, f.map.tile_oom_count());
+  LONGS_EQUAL(0, f.map.observation_oom_count());
+  LONGS_EQUAL(1, f.map.observations_used());
+  CHECK_TRUE(f.map.update(r, 15, 15, obs(1, 0)));  // same tile
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
+TEST(DpMap, out_of_bounds_and_dead_particles_are_refused_and_counted) {
+  DpFixture f(8U, 8U, small_options(4U, 64U));
+  const NodeId r = f.tree.create_root();
+  CHECK_FALSE(f.map.update(r, -1, 0, obs(1, 0)));
+  CHECK_FALSE(f.map.update(r, 48, 0, obs(1, 0)));
+  CHECK_FALSE(f.map.update(r, 0, 40, obs(1, 0)));
+  LONGS_EQUAL(3, f.map.out_of_bounds_count());
+  CHECK_FALSE(f.map.update(5U, 0, 0, obs(1, 0)));
+  CHECK_FALSE(f.map.update(kNoNode, 0, 0, obs(1, 0)));
+  LONGS_EQUAL(2, f.map.misuse_count());
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(r, 48, 0, &v));
+  CHECK_FALSE(f.map.lookup(kNoNode, 0, 0, &v));
+  LONGS_EQUAL(0, f.map.observations_used());
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
+TEST(DpMap, extraction_matches_lookup_and_touched_bounds_cover_written_tiles) {
+  DpFixture f(8U, 8U, small_options(9U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  CHECK_FALSE(f.map.touched_bounds(nullptr));
+  CHECK_TRUE(f.map.update(r, 17, 3, obs(1, 2)));
+  const NodeId c = t.add_child(r);
+  CHECK_TRUE(f.map.update(c, 47, 39, obs(3, 4)));
+  sdpslam::CellRect b;
+  CHECK_TRUE(f.map.touched_bounds(&b));
+  LONGS_EQUAL(16, b.ix0);
+  LONGS_EQUAL(0, b.iy0);
+  LONGS_EQUAL(32U, b.width);   // tiles 1..2 clipped to 48 cells
+  LONGS_EQUAL(40U, b.height);  // tiles 0..2 clipped to 40 cells
+  std::vector<std::int32_t> seen;
+  f.map.for_each_known_cell(c, [&](std::int32_t ix, std::int32_t iy, const CellObservation& v) {
+    seen.push_back(ix);
+    seen.push_back(iy);
+    seen.push_back(v.hits);
+  });
+  const std::vector<std::int32_t> expect{17, 3, 1, 47, 39, 3};
+  CHECK_TRUE(expect == seen);
+  sdpslam::CellRect rect{46, 38, 4, 3};  // partly outside the map
+  std::vector<CellObservation> values(12);
+  std::vector<std::uint8_t> known(12, 9);
+  LONGS_EQUAL(1, f.map.fill_rect(c, rect, values.data(), known.data()));
+  LONGS_EQUAL(1, known[1 * 4 + 1]);
+  CHECK_TRUE(values[1 * 4 + 1] == obs(3, 4));
+  LONGS_EQUAL(0, known[0]);
+  LONGS_EQUAL(0, known[11]);
+  LONGS_EQUAL(0, f.map.fill_rect(r, rect, values.data(), known.data()));
+}
+
+TEST(DpMap, footprint_reports_the_fixed_storage) {
+  DpFixture f(8U, 8U, small_options(4U, 100U));
+  CHECK(f.map.footprint_bytes() >= 100U * 20U + 4U * 1024U + 9U * 4U);
+}
