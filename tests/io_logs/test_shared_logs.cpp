@@ -1,0 +1,110 @@
+// The real logs in ../shared/datasets: record counts from its README, exact stamps,
+// a plausible tinySLAM odometry path, and the reader's throughput on intel.clf.
+#include <CppUTest/TestHarness.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "shared_data.h"
+#include "sdpslam/io/log_reader.h"
+
+using sdpslam::io::LogContents;
+using sdpslam::io::LogFormat;
+using sdpslam::io::LogReader;
+using sdpslam::io::LogReaderOptions;
+
+namespace {
+LogContents read_shared(const std::string& name) {
+  LogContents c;
+  std::string error;
+  CHECK_TEXT(sdpslam::io::read_whole_log(sdpslam::test::shared_path(name), LogReaderOptions{}, &c, &error),
+             error.c_str());
+  for (const auto& e : c.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
+  return c;
+}
+
+bool all_have_beams(const LogContents& c, std::uint32_t n) {
+  return std::all_of(c.lasers.begin(), c.lasers.end(), [n](const auto& l) { return l.scan.beam_count == n; });
+}
+}  // namespace
+
+TEST_GROUP(SharedLogs){};
+
+TEST(SharedLogs, intel_has_the_readme_counts_and_no_errors) {
+  const LogContents c = read_shared("datasets/intel.clf");
+  CHECK(c.format == LogFormat::kCarmen);
+  CHECK_EQUAL(0U, c.error_count);
+  CHECK_EQUAL(26915U, c.odoms.size());
+  CHECK_EQUAL(13631U, c.lasers.size());
+  CHECK(all_have_beams(c, 180));
+  // First FLASER line of the file: "... 976052857.337530 nohost 0.000246".
+  CHECK_EQUAL(976052857337530LL, c.lasers.front().stamp_us);
+  CHECK_EQUAL(246LL, c.lasers.front().logger_stamp_us);
+  CHECK_EQUAL(1.07F, c.lasers.front().scan.ranges_m[0]);
+  // The raw log's ipc stamps step back now and then (by up to ~0.6 s); the README's
+  // 2691 s span is what holds.
+  const double span_s = static_cast<double>(c.lasers.back().stamp_us - c.lasers.front().stamp_us) * 1e-6;
+  CHECK(span_s > 2680.0 && span_s < 2700.0);
+}
+
+TEST(SharedLogs, aces_has_the_readme_counts_and_no_errors) {
+  const LogContents c = read_shared("datasets/aces.clf");
+  CHECK_EQUAL(0U, c.error_count);
+  CHECK_EQUAL(7375U, c.odoms.size());
+  CHECK_EQUAL(7374U, c.lasers.size());
+  CHECK(all_have_beams(c, 180));
+  CHECK_EQUAL(4U, c.params.size());
+}
+
+TEST(SharedLogs, tinyslam_exp2_has_one_scan_per_line_and_a_plausible_indoor_path) {
+  const LogContents c = read_shared("datasets/tinyslam-exp2.dat");
+  CHECK(c.format == LogFormat::kTinySlam);
+  CHECK_EQUAL(0U, c.error_count);
+  CHECK_EQUAL(641U, c.lasers.size());
+  CHECK(all_have_beams(c, 682));
+  double dist_m = 0.0;
+  double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;
+  for (std::size_t i = 1; i < c.lasers.size(); ++i) {
+    const auto& a = c.lasers[i - 1].odom_pose;
+    const auto& b = c.lasers[i].odom_pose;
+    dist_m += std::hypot(b.x_m - a.x_m, b.y_m - a.y_m);
+    min_x = std::min(min_x, b.x_m);
+    max_x = std::max(max_x, b.x_m);
+    min_y = std::min(min_y, b.y_m);
+    max_y = std::max(max_y, b.y_m);
+  }
+  const double duration_s = static_cast<double>(c.lasers.back().stamp_us - c.lasers.front().stamp_us) * 1e-6;
+  std::fprintf(stderr, "tinyslam-exp2: %zu scans, %.1f s, odometry path %.2f m, bbox x [%.2f, %.2f] y [%.2f, %.2f] m\n",
+               c.lasers.size(), duration_s, dist_m, min_x, max_x, min_y, max_y);
+  // A small indoor robot: tens of metres in about a minute, inside a building-sized box.
+  CHECK(dist_m > 5.0 && dist_m < 100.0);
+  CHECK(max_x - min_x < 50.0 && max_y - min_y < 50.0);
+}
+
+TEST(SharedLogs, dpslam_loop5_has_551_scans_of_181_beams) {
+  const LogContents c = read_shared("datasets/dpslam-loop5.log");
+  CHECK(c.format == LogFormat::kDpSlam);
+  CHECK_EQUAL(0U, c.error_count);
+  CHECK_EQUAL(551U, c.lasers.size());
+  CHECK(all_have_beams(c, 181));
+  CHECK(std::all_of(c.lasers.begin(), c.lasers.end(), [](const auto& l) { return l.has_odom_pose && !l.has_stamp; }));
+  CHECK_EQUAL(550LL * 100000LL, c.lasers.back().stamp_us);
+}
+
+TEST(SharedLogs, intel_streaming_read_throughput) {
+  const std::string path = sdpslam::test::shared_path("datasets/intel.clf");
+  LogReader r;
+  std::string error;
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK_TEXT(r.open(path, LogReaderOptions{}, &error), error.c_str());
+  std::size_t records = 0;
+  while (r.next() != LogReader::Next::kEnd) ++records;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double mb = static_cast<double>(r.input_offset()) / 1e6;
+  std::fprintf(stderr, "intel.clf: %lld lines, %zu records, %.1f MB in %.3f s: %.0f lines/s, %.1f MB/s\n",
+               static_cast<long long>(r.lines_read()), records, mb, s, static_cast<double>(r.lines_read()) / s, mb / s);
+  CHECK_EQUAL(40557LL, r.lines_read());
+}
