@@ -1,0 +1,291 @@
+// `sdpslam evaluate`: accuracy of a trajectory.
+//
+//   sdpslam evaluate --log LOG --relations FILE (--trajectory TRAJ | --odometry)
+//       relations metric (Kümmerle et al. 2009) against a Freiburg `.relations` file.
+//       The log supplies the laser stamps and the odometry pose at every scan: scans the
+//       trajectory has no pose for are filled with the last estimate composed with
+//       odometry (tools/eval/include/sdpslam/eval/relations.h). --odometry evaluates the
+//       log's own odometry poses (the "raw odometry" baseline).
+//   sdpslam evaluate --trajectory TRAJ --ground-truth GT
+//       absolute trajectory error after the best SE(2) alignment.
+//
+// Both can be asked for at once. --json FILE writes the figures as JSON (atomically).
+// Exit codes (cli_common.h): bad or inconsistent input → kExitBadInput with file:line.
+#include <cinttypes>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli_common.h"
+#include "sdpslam/eval/ate.h"
+#include "sdpslam/eval/log_scans.h"
+#include "sdpslam/eval/relations.h"
+#include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/trajectory_io.h"
+
+namespace sdpslam::cli {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+struct EvaluateArgs {
+  std::string log_path;
+  std::string relations_path;
+  std::string trajectory_path;
+  std::string ground_truth_path;
+  std::string json_path;
+  bool odometry = false;
+  std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
+};
+
+// ---- minimal JSON writer (the output is small and flat) --------------------------------
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += ch;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string json_stats(const eval::ErrorStats& s) {
+  return "{\"mean\": " + json_number(s.mean) + ", \"std\": " + json_number(s.std_dev) +
+         ", \"max\": " + json_number(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
+}
+
+// ---- inputs ------------------------------------------------------------------------------
+
+int read_scan_odometry(const std::string& log_path, std::vector<io::StampedPose>* scans) {
+  eval::LogScansReport rep;
+  std::string error;
+  const bool ok = eval::read_log_scan_odometry(log_path, scans, &rep, &error);
+  if (rep.malformed_line_count > 0) {
+    std::fprintf(stderr, "sdpslam evaluate: %zu malformed line(s) of %s skipped; first: %s\n", rep.malformed_line_count,
+                 log_path.c_str(), rep.first_malformed.c_str());
+  }
+  if (!ok) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  if (rep.without_odometry_count > 0) {
+    std::fprintf(stderr, "sdpslam evaluate: %s: %zu laser scan(s) carry no odometry pose and are left out\n",
+                 log_path.c_str(), rep.without_odometry_count);
+  }
+  return kExitOk;
+}
+
+int read_trajectory_file(const std::string& path, std::vector<io::StampedPose>* poses) {
+  std::string error;
+  if (!io::read_trajectory(path, poses, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  if (poses->empty()) {
+    std::fprintf(stderr, "sdpslam evaluate: %s: no poses\n", path.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+// ---- the two evaluations ----------------------------------------------------------------
+
+int run_relations(const EvaluateArgs& a, std::string* json) {
+  std::vector<eval::Relation> relations;
+  std::string error;
+  if (!eval::read_relations(a.relations_path, &relations, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  if (relations.empty()) {
+    std::fprintf(stderr, "sdpslam evaluate: %s: no relations\n", a.relations_path.c_str());
+    return kExitBadInput;
+  }
+  std::vector<io::StampedPose> scans;
+  if (const int rc = read_scan_odometry(a.log_path, &scans); rc != kExitOk) return rc;
+
+  std::vector<io::StampedPose> per_scan;
+  eval::FillReport fill;
+  std::string source;
+  if (a.odometry) {
+    per_scan = scans;
+    fill.scan_count = fill.estimated_count = scans.size();
+    source = "odometry of " + a.log_path;
+  } else {
+    std::vector<io::StampedPose> estimate;
+    if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
+    if (!eval::fill_with_odometry(estimate, scans, a.tolerance_us, &per_scan, &fill, &error)) {
+      std::fprintf(stderr, "sdpslam evaluate: %s against %s: %s\n", a.trajectory_path.c_str(), a.log_path.c_str(),
+                   error.c_str());
+      return kExitBadInput;
+    }
+    source = a.trajectory_path;
+  }
+
+  const eval::RelationsResult res = eval::evaluate_relations(relations, per_scan, a.tolerance_us);
+  for (const eval::Relation& r : res.unmatched) {
+    std::fprintf(stderr, "sdpslam evaluate: %s:%" PRId64 ": relation %s -> %s: a stamp matches no laser scan within %" PRId64
+                         " us; left out\n",
+                 a.relations_path.c_str(), r.line, io::format_stamp_us(r.t1_us).c_str(),
+                 io::format_stamp_us(r.t2_us).c_str(), a.tolerance_us);
+  }
+  if (res.unmatched_count > res.unmatched.size()) {
+    std::fprintf(stderr, "sdpslam evaluate: ... and %zu more unmatched relations\n",
+                 res.unmatched_count - res.unmatched.size());
+  }
+
+  std::printf("Relations metric (Kümmerle et al. 2009)\n");
+  std::printf("  relations   %s: %zu, used %zu (%zu exact stamp matches), unmatched %zu\n", a.relations_path.c_str(),
+              res.relation_count, res.used_count, res.exact_match_count, res.unmatched_count);
+  std::printf("  trajectory  %s: %zu scans, %zu estimated, %zu filled from odometry", source.c_str(), fill.scan_count,
+              fill.estimated_count, fill.filled_count);
+  if (fill.unmatched_estimate_count > 0) std::printf(", %zu poses matched no scan", fill.unmatched_estimate_count);
+  std::printf("\n");
+  std::printf("  %-22s %12s %12s %12s\n", "error", "mean", "std", "max");
+  const auto row = [](const char* name, const eval::ErrorStats& s) {
+    std::printf("  %-22s %12.6f %12.6f %12.6f\n", name, s.mean, s.std_dev, s.max);
+  };
+  row("translation [m]", res.translation_m);
+  row("translation^2 [m^2]", res.translation_m2);
+  row("rotation [deg]", res.rotation_deg);
+  row("rotation^2 [deg^2]", res.rotation_deg2);
+
+  *json += "\"relations\": {\"file\": " + json_string(a.relations_path) + ", \"log\": " + json_string(a.log_path) +
+           ", \"trajectory\": " + (a.odometry ? std::string("\"odometry\"") : json_string(a.trajectory_path)) +
+           ", \"relation_count\": " + std::to_string(res.relation_count) +
+           ", \"used_count\": " + std::to_string(res.used_count) +
+           ", \"exact_match_count\": " + std::to_string(res.exact_match_count) +
+           ", \"unmatched_count\": " + std::to_string(res.unmatched_count) +
+           ", \"scan_count\": " + std::to_string(fill.scan_count) +
+           ", \"filled_scan_count\": " + std::to_string(fill.filled_count) +
+           ", \"stamp_tolerance_us\": " + std::to_string(a.tolerance_us) +
+           ", \"translation_m\": " + json_stats(res.translation_m) +
+           ", \"translation_m2\": " + json_stats(res.translation_m2) +
+           ", \"rotation_deg\": " + json_stats(res.rotation_deg) +
+           ", \"rotation_deg2\": " + json_stats(res.rotation_deg2) + "}";
+  if (res.used_count == 0) {
+    std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
+                 a.log_path.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+int run_ate(const EvaluateArgs& a, std::string* json) {
+  std::vector<io::StampedPose> estimate;
+  std::vector<io::StampedPose> truth;
+  if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
+  if (const int rc = read_trajectory_file(a.ground_truth_path, &truth); rc != kExitOk) return rc;
+  eval::AteResult r;
+  if (!eval::compute_ate(estimate, truth, a.tolerance_us, &r)) {
+    std::fprintf(stderr, "sdpslam evaluate: no pose of %s has a ground-truth pose in %s within %" PRId64 " us\n",
+                 a.trajectory_path.c_str(), a.ground_truth_path.c_str(), a.tolerance_us);
+    return kExitBadInput;
+  }
+  if (r.unmatched_estimate_count > 0) {
+    std::fprintf(stderr, "sdpslam evaluate: %zu pose(s) of %s have no ground truth within %" PRId64 " us; left out\n",
+                 r.unmatched_estimate_count, a.trajectory_path.c_str(), a.tolerance_us);
+  }
+  std::printf("Absolute trajectory error (after SE(2) alignment)\n");
+  std::printf("  trajectory  %s: %zu poses, %zu matched to %s (%zu poses)\n", a.trajectory_path.c_str(),
+              r.estimate_count, r.matched_count, a.ground_truth_path.c_str(), r.ground_truth_count);
+  std::printf("  alignment   x %.6f m, y %.6f m, theta %.6f deg\n", r.alignment.x_m, r.alignment.y_m,
+              r.alignment.heading_rad * kRadToDeg);
+  std::printf("  position    rmse %.6f m, mean %.6f m, max %.6f m\n", r.rmse_m, r.mean_m, r.max_m);
+  std::printf("  heading     rmse %.6f deg\n", r.heading_rmse_rad * kRadToDeg);
+  *json += "\"ate\": {\"trajectory\": " + json_string(a.trajectory_path) +
+           ", \"ground_truth\": " + json_string(a.ground_truth_path) +
+           ", \"estimate_count\": " + std::to_string(r.estimate_count) +
+           ", \"ground_truth_count\": " + std::to_string(r.ground_truth_count) +
+           ", \"matched_count\": " + std::to_string(r.matched_count) +
+           ", \"unmatched_estimate_count\": " + std::to_string(r.unmatched_estimate_count) +
+           ", \"rmse_m\": " + json_number(r.rmse_m) + ", \"mean_m\": " + json_number(r.mean_m) +
+           ", \"max_m\": " + json_number(r.max_m) +
+           ", \"heading_rmse_deg\": " + json_number(r.heading_rmse_rad * kRadToDeg) +
+           ", \"alignment\": {\"x_m\": " + json_number(r.alignment.x_m) + ", \"y_m\": " + json_number(r.alignment.y_m) +
+           ", \"heading_rad\": " + json_number(r.alignment.heading_rad) + "}}";
+  return kExitOk;
+}
+
+int run_evaluate(const EvaluateArgs& a) {
+  const bool want_relations = !a.relations_path.empty();
+  const bool want_ate = !a.ground_truth_path.empty();
+  if (!want_relations && !want_ate) {
+    std::fprintf(stderr, "sdpslam evaluate: give --relations (with --log) or --ground-truth (with --trajectory)\n");
+    return kExitUsage;
+  }
+  if (want_relations && (a.log_path.empty() || (a.trajectory_path.empty() == !a.odometry))) {
+    std::fprintf(stderr, "sdpslam evaluate: --relations needs --log and exactly one of --trajectory, --odometry\n");
+    return kExitUsage;
+  }
+  if (want_ate && a.trajectory_path.empty()) {
+    std::fprintf(stderr, "sdpslam evaluate: --ground-truth needs --trajectory\n");
+    return kExitUsage;
+  }
+  if (a.tolerance_us < 0) {
+    std::fprintf(stderr, "sdpslam evaluate: --stamp-tolerance-us must not be negative\n");
+    return kExitUsage;
+  }
+  std::string json = "{";
+  if (want_relations) {
+    if (const int rc = run_relations(a, &json); rc != kExitOk) return rc;
+  }
+  if (want_ate) {
+    if (want_relations) {
+      json += ", ";
+      std::printf("\n");
+    }
+    if (const int rc = run_ate(a, &json); rc != kExitOk) return rc;
+  }
+  json += "}\n";
+  if (!a.json_path.empty()) {
+    std::string error;
+    if (!io::write_file_atomic(a.json_path, json, &error)) {
+      std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+      return kExitIo;
+    }
+  }
+  return kExitOk;
+}
+
+std::function<int()> setup_evaluate(CLI::App& app) {
+  auto args = std::make_shared<EvaluateArgs>();
+  app.add_option("--log", args->log_path, "robot log whose laser stamps and odometry the relations refer to");
+  app.add_option("--relations", args->relations_path, "ground-truth relations file (t1 t2 x y z roll pitch yaw)");
+  auto* traj = app.add_option("--trajectory", args->trajectory_path, "estimated trajectory (t x y theta, or TUM)");
+  app.add_flag("--odometry", args->odometry, "evaluate the log's own odometry poses (raw-odometry baseline)")
+      ->excludes(traj);
+  app.add_option("--ground-truth", args->ground_truth_path, "ground-truth trajectory for the absolute error");
+  app.add_option("--json", args->json_path, "also write the figures to this JSON file");
+  app.add_option("--stamp-tolerance-us", args->tolerance_us,
+                 "stamps closer than this name the same scan when not equal (default 1000)");
+  return [args] { return run_evaluate(*args); };
+}
+
+}  // namespace
+
+SDPSLAM_REGISTER_COMMAND(evaluate, "evaluate", "accuracy of a trajectory: relations metric and ATE", 40,
+                         setup_evaluate);
+
+}  // namespace sdpslam::cli

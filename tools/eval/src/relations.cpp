@@ -1,0 +1,173 @@
+// Relations metric (see relations.h).
+#include "sdpslam/eval/relations.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace sdpslam::eval {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+bool parse_finite(const std::string& token, double* value) {
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  if (token.empty() || end != begin + token.size() || errno == ERANGE || !std::isfinite(v)) return false;
+  *value = v;
+  return true;
+}
+
+}  // namespace
+
+bool read_relations(const std::string& path, std::vector<Relation>* relations, std::string* error) {
+  relations->clear();
+  std::ifstream in(path);
+  if (!in) {
+    if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  std::string line;
+  std::int64_t line_no = 0;
+  auto fail = [&](const std::string& reason) {
+    if (error != nullptr) *error = path + ":" + std::to_string(line_no) + ": " + reason;
+    return false;
+  };
+  static const char* const kColumns[] = {"t1", "t2", "x", "y", "z", "roll", "pitch", "yaw"};
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    std::vector<std::string> tokens;
+    for (std::string t; fields >> t;) tokens.push_back(t);
+    if (tokens.size() != 8) {
+      return fail("expected 8 columns (t1 t2 x y z roll pitch yaw), found " + std::to_string(tokens.size()));
+    }
+    Relation r;
+    r.line = line_no;
+    if (!io::parse_stamp_us(tokens[0], &r.t1_us)) return fail("bad timestamp t1 '" + tokens[0] + "'");
+    if (!io::parse_stamp_us(tokens[1], &r.t2_us)) return fail("bad timestamp t2 '" + tokens[1] + "'");
+    double v[6] = {};
+    for (std::size_t k = 2; k < 8; ++k) {
+      if (!parse_finite(tokens[k], &v[k - 2])) {
+        return fail(std::string("column ") + kColumns[k] + " '" + tokens[k] + "' is not a finite number");
+      }
+    }
+    r.expected = Pose2{v[0], v[1], normalize_angle_rad(v[5])};
+    relations->push_back(r);
+  }
+  if (in.bad()) {
+    if (error != nullptr) *error = "read error on '" + path + "' after line " + std::to_string(line_no);
+    return false;
+  }
+  return true;
+}
+
+bool fill_with_odometry(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& scan_odometry,
+                        std::int64_t tolerance_us, std::vector<io::StampedPose>* per_scan, FillReport* report,
+                        std::string* error) {
+  FillReport rep;
+  rep.scan_count = scan_odometry.size();
+  std::size_t bad = 0;
+  if (!stamps_strictly_increasing(scan_odometry, &bad)) {
+    if (error != nullptr) {
+      *error = "scan stamps are not strictly increasing at scan " + std::to_string(bad) + " (" +
+               io::format_stamp_us(scan_odometry[bad].stamp_us) + " after " +
+               io::format_stamp_us(scan_odometry[bad - 1].stamp_us) + ")";
+    }
+    if (report != nullptr) *report = rep;
+    return false;
+  }
+  std::vector<io::StampedPose> out(scan_odometry.size());
+  std::vector<bool> has(scan_odometry.size(), false);
+  for (const io::StampedPose& e : estimate) {
+    std::size_t k = 0;
+    if (find_stamp(scan_odometry, e.stamp_us, tolerance_us, &k) == StampMatch::kNone) {
+      ++rep.unmatched_estimate_count;
+      continue;
+    }
+    if (has[k]) ++rep.duplicate_estimate_count;
+    has[k] = true;
+    out[k] = io::StampedPose{scan_odometry[k].stamp_us, e.pose};
+  }
+  std::size_t first = scan_odometry.size();
+  for (std::size_t k = 0; k < has.size(); ++k) {
+    if (has[k]) {
+      ++rep.estimated_count;
+      if (first == scan_odometry.size()) first = k;
+    }
+  }
+  if (first == scan_odometry.size()) {
+    if (error != nullptr) {
+      *error = "none of the " + std::to_string(estimate.size()) + " estimated poses matches any of the " +
+               std::to_string(scan_odometry.size()) + " laser scan stamps";
+    }
+    if (report != nullptr) *report = rep;
+    return false;
+  }
+  // Backwards from the first estimate, then forwards from the last one seen.
+  for (std::size_t k = 0; k < first; ++k) {
+    out[k] = io::StampedPose{scan_odometry[k].stamp_us,
+                             out[first].pose.compose(between(scan_odometry[first].pose, scan_odometry[k].pose))};
+    ++rep.filled_count;
+  }
+  std::size_t last = first;
+  for (std::size_t k = first + 1; k < has.size(); ++k) {
+    if (has[k]) {
+      last = k;
+      continue;
+    }
+    out[k] = io::StampedPose{scan_odometry[k].stamp_us,
+                             out[last].pose.compose(between(scan_odometry[last].pose, scan_odometry[k].pose))};
+    ++rep.filled_count;
+  }
+  *per_scan = std::move(out);
+  if (report != nullptr) *report = rep;
+  return true;
+}
+
+RelationsResult evaluate_relations(const std::vector<Relation>& relations, const std::vector<io::StampedPose>& per_scan,
+                                   std::int64_t tolerance_us) {
+  RelationsResult res;
+  res.relation_count = relations.size();
+  std::vector<double> t_abs, t_sq, r_abs, r_sq;
+  for (const Relation& rel : relations) {
+    std::size_t i1 = 0;
+    std::size_t i2 = 0;
+    const StampMatch m1 = find_stamp(per_scan, rel.t1_us, tolerance_us, &i1);
+    const StampMatch m2 = find_stamp(per_scan, rel.t2_us, tolerance_us, &i2);
+    if (m1 == StampMatch::kNone || m2 == StampMatch::kNone) {
+      ++res.unmatched_count;
+      if (res.unmatched.size() < RelationsResult::kMaxUnmatchedKept) res.unmatched.push_back(rel);
+      continue;
+    }
+    if (m1 == StampMatch::kExact && m2 == StampMatch::kExact) ++res.exact_match_count;
+    RelationResult rr;
+    rr.relation = rel;
+    // Eq. (2): δ_est = p1⁻¹ ⊕ p2, E = δ_est ⊖ δ_true = δ_est ⊕ δ_true⁻¹.
+    rr.error = between(per_scan[i1].pose, per_scan[i2].pose).compose(rel.expected.inverse());
+    rr.translation_error_m = std::hypot(rr.error.x_m, rr.error.y_m);
+    rr.rotation_error_rad = std::fabs(normalize_angle_rad(rr.error.heading_rad));
+    const double deg = rr.rotation_error_rad * kRadToDeg;
+    t_abs.push_back(rr.translation_error_m);
+    t_sq.push_back(rr.translation_error_m * rr.translation_error_m);
+    r_abs.push_back(deg);
+    r_sq.push_back(deg * deg);
+    res.per_relation.push_back(rr);
+  }
+  res.used_count = res.per_relation.size();
+  res.translation_m = summarize(t_abs);
+  res.translation_m2 = summarize(t_sq);
+  res.rotation_deg = summarize(r_abs);
+  res.rotation_deg2 = summarize(r_sq);
+  return res;
+}
+
+}  // namespace sdpslam::eval
