@@ -1,0 +1,143 @@
+// `sdpslam evaluate` end to end: figures on a tiny synthetic log, JSON output, and exit
+// codes with file:line for bad input.
+#include <CppUTest/TestHarness.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "sdpslam/io/atomic_file.h"
+#include "shared_data.h"
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+Run run_evaluate(const std::string& args) {
+  Run r;
+  const std::string cmd = std::string(SDPSLAM_CLI_PATH) + " evaluate " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_GROUP(CliEvaluate) {
+  std::string dir;
+  void setup() override { dir = sdpslam::test::make_temp_dir("cli-eval"); }
+  void teardown() override {
+    for (const char* f : {"/log.clf", "/r.relations", "/t.txt", "/gt.txt", "/bad.txt", "/out.json"}) {
+      ::unlink((dir + f).c_str());
+    }
+    ::rmdir(dir.c_str());
+  }
+  std::string put(const char* name, const std::string& text) {
+    std::string error;
+    const std::string p = dir + "/" + name;
+    CHECK_TRUE(sdpslam::io::write_file_atomic(p, text, &error));
+    return p;
+  }
+  // Three scans driving 1 m straight ahead each; odometry says 1.1 m per step.
+  std::string log() {
+    return put("log.clf",
+               "FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 10.000000 host 0.1\n"
+               "FLASER 3 1.0 2.0 3.0 1.1 0 0 1.1 0 0 11.000000 host 1.1\n"
+               "FLASER 3 1.0 2.0 3.0 2.2 0 0 2.2 0 0 12.000000 host 2.1\n");
+  }
+  std::string relations() {
+    return put("r.relations",
+               "10.000000 11.000000 1.0 0 0 0 0 0\n"
+               "11.000000 12.000000 1.0 0 0 0 0 0\n");
+  }
+};
+
+TEST(CliEvaluate, odometry_relations_figures_and_json) {
+  const std::string json = dir + "/out.json";
+  const Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --odometry --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("used 2 (2 exact stamp matches), unmatched 0", r.out.c_str());
+  STRCMP_CONTAINS("translation [m]            0.100000     0.000000     0.100000", r.out.c_str());
+  const std::string j = slurp(json);
+  STRCMP_CONTAINS("\"used_count\": 2", j.c_str());
+  STRCMP_CONTAINS("\"translation_m\": {\"mean\": 0.1", j.c_str());
+}
+
+TEST(CliEvaluate, sparse_trajectory_is_filled_with_odometry) {
+  // Only the first scan estimated: the rest comes from odometry, so figures equal the
+  // odometry's.
+  const std::string t = put("t.txt", "10.000000 0 0 0\n");
+  const Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("3 scans, 1 estimated, 2 filled from odometry", r.out.c_str());
+  STRCMP_CONTAINS("translation [m]            0.100000", r.out.c_str());
+}
+
+TEST(CliEvaluate, ate_of_shifted_copy_is_zero) {
+  const std::string gt = put("gt.txt", "1 0 0 0\n2 1 0 0\n3 1 1 1.5\n");
+  const std::string t = put("t.txt", "1 5 5 0\n2 6 5 0\n3 6 6 1.5\n");
+  const Run r = run_evaluate("--trajectory " + t + " --ground-truth " + gt);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("rmse 0.000000 m", r.out.c_str());
+  STRCMP_CONTAINS("3 matched", r.out.c_str());
+}
+
+TEST(CliEvaluate, malformed_trajectory_is_bad_input_with_file_and_line) {
+  const std::string bad = put("bad.txt", "1 0 0 0\n2 0 oops 0\n");
+  const std::string gt = put("gt.txt", "1 0 0 0\n");
+  const Run r = run_evaluate("--trajectory " + bad + " --ground-truth " + gt);
+  LONGS_EQUAL(3, r.status);
+  STRCMP_CONTAINS((bad + ":2:").c_str(), r.out.c_str());
+}
+
+TEST(CliEvaluate, malformed_relations_file_is_bad_input_with_file_and_line) {
+  const std::string rel = put("r.relations", "10 11 1 0 0 0 0 0\n10 11 1 0\n");
+  const Run r = run_evaluate("--log " + log() + " --relations " + rel + " --odometry");
+  LONGS_EQUAL(3, r.status);
+  STRCMP_CONTAINS((rel + ":2:").c_str(), r.out.c_str());
+}
+
+TEST(CliEvaluate, missing_input_file_is_bad_input) {
+  const Run r = run_evaluate("--trajectory " + dir + "/none.txt --ground-truth " + dir + "/none.txt");
+  LONGS_EQUAL(3, r.status);
+  STRCMP_CONTAINS("none.txt", r.out.c_str());
+}
+
+TEST(CliEvaluate, relations_without_a_trajectory_source_is_a_usage_error) {
+  const Run r = run_evaluate("--log " + log() + " --relations " + relations());
+  LONGS_EQUAL(2, r.status);
+  STRCMP_CONTAINS("--odometry", r.out.c_str());
+}
+
+TEST(CliEvaluate, unmatched_relations_are_reported) {
+  const std::string rel = put("r.relations", "10 11 1 0 0 0 0 0\n11 13 1 0 0 0 0 0\n");
+  const Run r = run_evaluate("--log " + log() + " --relations " + rel + " --odometry");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS((rel + ":2: relation 11.000000 -> 13.000000").c_str(), r.out.c_str());
+  STRCMP_CONTAINS("used 1 (1 exact stamp matches), unmatched 1", r.out.c_str());
+}
+
+TEST(CliEvaluate, unwritable_json_is_an_output_error) {
+  const std::string gt = put("gt.txt", "1 0 0 0\n");
+  const Run r = run_evaluate("--trajectory " + gt + " --ground-truth " + gt + " --json " + dir + "/no/dir/out.json");
+  LONGS_EQUAL(4, r.status);
+  STRCMP_CONTAINS("no/dir/out.json", r.out.c_str());
+}
