@@ -1,0 +1,124 @@
+// `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz)
+// to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
+// skipped and listed ("file:line: reason"), never fatal.
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli_common.h"
+#include "sdpslam/io/carmen_writer.h"
+#include "sdpslam/io/log_reader.h"
+
+namespace sdpslam::cli {
+namespace {
+
+constexpr std::size_t kErrorsPrinted = 20;
+
+struct ConvertArgs {
+  std::string in;
+  std::string out;
+  std::string format = "auto";
+  io::WheelOdometryParams wheels;
+};
+
+int run_convert(const ConvertArgs& a) {
+  io::LogReaderOptions options;
+  options.wheels = a.wheels;
+  options.max_errors_kept = kErrorsPrinted;
+  if (a.format == "carmen") options.format = io::LogFormat::kCarmen;
+  if (a.format == "tinyslam") options.format = io::LogFormat::kTinySlam;
+  if (a.format == "dpslam") options.format = io::LogFormat::kDpSlam;
+
+  io::LogReader reader;
+  std::string error;
+  if (!reader.open(a.in, options, &error)) {
+    std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  io::CarmenWriter writer;
+  if (!writer.open(a.out, &error)) {
+    std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+    return kExitIo;
+  }
+  writer.comment("converted by sdpslam from " + a.in + " (" + io::to_string(reader.format()) + ")");
+
+  struct stat st {};
+  const std::uint64_t size_kib = ::stat(a.in.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) / 1024U : 0U;
+  Progress progress("KiB", size_kib);
+  std::uint64_t lasers = 0;
+  std::uint64_t odoms = 0;
+  std::uint64_t params = 0;
+  // Formats without ODOM lines (tinySLAM) get one per scan from the scan's odometry pose.
+  const bool synth_odom = reader.format() == io::LogFormat::kTinySlam;
+  for (;;) {
+    const io::LogReader::Next n = reader.next();
+    if (n == io::LogReader::Next::kEnd) break;
+    if (n == io::LogReader::Next::kLaser) {
+      const io::LaserRecord& l = reader.laser();
+      if (synth_odom && l.has_odom_pose) {
+        io::OdomRecord o;
+        o.stamp_us = l.stamp_us;
+        o.logger_stamp_us = l.logger_stamp_us;
+        o.pose = l.odom_pose;
+        writer.odom(o);
+        ++odoms;
+      }
+      writer.laser(l);
+      ++lasers;
+    } else if (n == io::LogReader::Next::kOdom) {
+      writer.odom(reader.odom());
+      ++odoms;
+    } else {
+      writer.param(reader.param().name, reader.param().value);
+      ++params;
+    }
+    progress.update(reader.input_offset() / 1024U);
+  }
+  progress.finish();
+
+  for (const io::LogError& e : reader.errors()) std::fprintf(stderr, "%s\n", e.to_string().c_str());
+  if (reader.error_count() > reader.errors().size()) {
+    std::fprintf(stderr, "... and %zu more skipped lines\n", reader.error_count() - reader.errors().size());
+  }
+  if (!writer.close(&error)) {
+    std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+    return kExitIo;
+  }
+  std::printf("converted %s (%s): %llu scans, %llu odometry, %llu params from %lld lines -> %s\n", a.in.c_str(),
+              io::to_string(reader.format()), static_cast<unsigned long long>(lasers),
+              static_cast<unsigned long long>(odoms), static_cast<unsigned long long>(params),
+              static_cast<long long>(reader.lines_read()), a.out.c_str());
+  if (reader.error_count() > 0) {
+    std::fprintf(stderr, "warning: %zu input lines skipped (%zu of them unknown message types)\n",
+                 reader.error_count(), reader.warning_count());
+  }
+  return kExitOk;
+}
+
+std::function<int()> setup_convert(CLI::App& app) {
+  auto args = std::make_shared<ConvertArgs>();
+  app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted)")->required();
+  app.add_option("OUT", args->out, "output CARMEN log (written atomically)")->required();
+  app.add_option("--format", args->format, "input format")
+      ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam"}))
+      ->capture_default_str();
+  app.add_option("--ticks-per-rev", args->wheels.ticks_per_rev, "encoder ticks per wheel revolution (tinySLAM)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--wheel-radius", args->wheels.wheel_radius_m, "wheel radius, m (tinySLAM)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--wheel-separation", args->wheels.wheel_separation_m, "distance between the wheels, m (tinySLAM)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  return [args] { return run_convert(*args); };
+}
+
+}  // namespace
+
+SDPSLAM_REGISTER_COMMAND(convert, "convert", "convert a robot log (CARMEN, tinySLAM, DP-SLAM) to a CARMEN log", 20,
+                         setup_convert);
+
+}  // namespace sdpslam::cli
