@@ -96,6 +96,7 @@ TEST(CandumpLogLine, malformed_lines_name_reason_and_column) {
       {"(1.000000) can0", CandumpError::kMissingFrame, 16},
       {"(1.000000) averyveryverylongname 123#11", CandumpError::kInterfaceTooLong, 12},
       {"(1.000000) can0 12#11", CandumpError::kBadId, 17},
+      {"(1.000000) c\x01n0 123#11", CandumpError::kBadInterfaceChar, 13},
       {"(1.000000) can0 800#11", CandumpError::kIdOutOfRange, 17},
       {"(1.000000) can0 1G3#11", CandumpError::kBadHexDigit, 18},
       {"(1.000000) can0 123", CandumpError::kMissingSeparator, 20},
@@ -266,4 +267,20 @@ TEST(CandumpFiles, writer_output_reads_back_identically) {
   }
   LONGS_EQUAL(50, n);
   LONGS_EQUAL(0, reader.errors());
+}
+
+TEST(CandumpFiles, nul_byte_in_a_line_is_reported_not_truncated_away) {
+  const std::string path = dir + "/nul.log";
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  const char line[] = "(1.000000) c\0n0 123#11\n(2.000000) can0 124#\n";
+  std::fwrite(line, 1, sizeof line - 1, f);
+  std::fclose(f);
+  CandumpReader reader;
+  reader.open(path.c_str());
+  CandumpRecord r;
+  LONGS_EQUAL(-1, reader.next(r));
+  CHECK(reader.error() == CandumpError::kBadInterfaceChar);
+  LONGS_EQUAL(13, reader.column());
+  LONGS_EQUAL(1, reader.next(r));
+  LONGS_EQUAL(0x124, r.frame.id);
 }

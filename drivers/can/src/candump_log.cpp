@@ -11,6 +11,7 @@ const char* to_string(CandumpError e) {
     case CandumpError::kBadTimestamp: return "malformed timestamp, expected (sec.usec) with 6 usec digits";
     case CandumpError::kMissingInterface: return "missing interface name";
     case CandumpError::kInterfaceTooLong: return "interface name longer than 15 characters";
+    case CandumpError::kBadInterfaceChar: return "control or non-ASCII byte in the interface name";
     case CandumpError::kMissingFrame: return "missing frame";
     case CandumpError::kBadId: return "identifier must be 3 (standard) or 8 (extended) hex digits";
     case CandumpError::kIdOutOfRange: return "standard identifier above 0x7FF";
@@ -91,6 +92,10 @@ CandumpParseResult parse_interface(Cursor& c, char (&name)[16]) {
   const std::string_view tok = c.token();
   if (tok.empty()) return fail(CandumpError::kMissingInterface, start);
   if (tok.size() > 15) return fail(CandumpError::kInterfaceTooLong, start);
+  for (std::size_t k = 0; k < tok.size(); ++k) {
+    const auto ch = static_cast<unsigned char>(tok[k]);
+    if (ch < 0x21 || ch > 0x7E) return fail(CandumpError::kBadInterfaceChar, start + k);
+  }
   std::memcpy(name, tok.data(), tok.size());
   name[tok.size()] = '\0';
   return CandumpParseResult{CandumpLineKind::kFrame, CandumpError::kNone, 0};
@@ -283,16 +288,24 @@ int CandumpReader::next(CandumpRecord& out) {
     column_ = 0;
     return -1;
   }
-  while (std::fgets(line_, sizeof line_, file_) != nullptr) {
-    ++line_number_;
-    std::size_t len = std::strlen(line_);
-    if (len == sizeof line_ - 1 && line_[len - 1] != '\n' && !std::feof(file_)) {
-      // Discard the rest of the over-long line; report it once.
-      int ch;
-      while ((ch = std::fgetc(file_)) != EOF && ch != '\n') {
+  for (;;) {
+    // Read one line byte by byte (NUL bytes included, so they are reported, not hidden).
+    std::size_t len = 0;
+    bool too_long = false;
+    int ch = EOF;
+    while ((ch = std::fgetc(file_)) != EOF) {
+      if (len < sizeof line_) {
+        line_[len++] = static_cast<char>(ch);
+      } else {
+        too_long = true;
       }
+      if (ch == '\n') break;
+    }
+    if (len == 0 && ch == EOF) break;
+    ++line_number_;
+    if (too_long) {
       error_ = CandumpError::kLineTooLong;
-      column_ = sizeof line_;
+      column_ = sizeof line_ + 1;
       errors_++;
       return -1;
     }

@@ -40,6 +40,7 @@ enum class CandumpError : std::uint8_t {
   kBadTimestamp,      // "(sec.usec)" malformed (usec must be 6 digits)
   kMissingInterface,
   kInterfaceTooLong,  // more than 15 characters
+  kBadInterfaceChar,  // control or non-ASCII byte in the interface name
   kMissingFrame,
   kBadId,             // not 3 or 8 hex digits
   kIdOutOfRange,      // standard id > 0x7FF
