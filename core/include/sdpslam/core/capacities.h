@@ -50,3 +50,41 @@ inline constexpr std::uint32_t kDpTileCells = kDpTileSideCells * kDpTileSideCell
 inline constexpr std::uint32_t kDpMaxTiles = 0xFFFFFFFFU >> (2U * kDpTileSideLog2);
 
 }  // namespace sdpslam::capacity
+
+// ---- Top level: ICP matching, free-space skeleton, graph of segments (paper §III) ---
+namespace sdpslam::capacity {
+
+#ifndef SDPSLAM_MAX_ICP_POINTS
+#define SDPSLAM_MAX_ICP_POINTS 2048
+#endif
+#ifndef SDPSLAM_ICP_HASH_BUCKETS_LOG2
+#define SDPSLAM_ICP_HASH_BUCKETS_LOG2 12
+#endif
+#ifndef SDPSLAM_MAX_SKELETON_PATCH_SIDE
+#define SDPSLAM_MAX_SKELETON_PATCH_SIDE 2048
+#endif
+#ifndef SDPSLAM_MAX_PGS_LEVELS
+#define SDPSLAM_MAX_PGS_LEVELS 256
+#endif
+
+// Points in each of the two sets one ICP call aligns (skeleton points of a submap).
+inline constexpr std::uint32_t kMaxIcpPoints = SDPSLAM_MAX_ICP_POINTS;
+static_assert(kMaxIcpPoints >= 8U && kMaxIcpPoints <= 65536U, "kMaxIcpPoints out of range");
+// Buckets of ICP's nearest-neighbour grid hash (a power of two, >= the point count so
+// that chains stay short).
+inline constexpr std::uint32_t kIcpHashBucketsLog2 = SDPSLAM_ICP_HASH_BUCKETS_LOG2;
+static_assert(kIcpHashBucketsLog2 >= 4U && kIcpHashBucketsLog2 <= 20U, "kIcpHashBucketsLog2 out of range [4,20]");
+inline constexpr std::uint32_t kIcpHashBuckets = 1U << kIcpHashBucketsLog2;
+
+// Largest side, in cells, of a grid patch whose free-space skeleton is extracted (the
+// scratch buffers themselves are sized at init for the patch the caller asks for).
+inline constexpr std::uint32_t kMaxSkeletonPatchSide = SDPSLAM_MAX_SKELETON_PATCH_SIDE;
+static_assert(kMaxSkeletonPatchSide >= 3U && kMaxSkeletonPatchSide <= 8192U, "kMaxSkeletonPatchSide out of range");
+
+// Levels (segments) the Probabilistic Graph of Segments keeps live before the oldest are
+// made permanent; nodes per level are bounded by kMaxBottomParticles (one submap each).
+inline constexpr std::uint32_t kMaxPgsLevels = SDPSLAM_MAX_PGS_LEVELS;
+static_assert(kMaxPgsLevels >= 2U && kMaxPgsLevels <= 65536U, "kMaxPgsLevels out of range");
+inline constexpr std::uint32_t kMaxPgsNodesPerLevel = kMaxBottomParticles;
+
+}  // namespace sdpslam::capacity

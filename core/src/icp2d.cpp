@@ -1,0 +1,244 @@
+// 2D point-to-point ICP; see icp2d.h for the contract.
+#include "sdpslam/core/icp2d.h"
+
+#include <cmath>  // std::floor only (exact in IEEE-754)
+#include <limits>
+
+#include "sdpslam/core/det_math.h"
+
+namespace sdpslam {
+namespace {
+
+constexpr double kMaxAbsCoordinate_m = 1.0e6;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+bool coordinates_ok(const Point2* points, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = points[i].x_m;
+    const double y = points[i].y_m;
+    // Written so that NaN fails too.
+    if (!(x > -kMaxAbsCoordinate_m && x < kMaxAbsCoordinate_m && y > -kMaxAbsCoordinate_m &&
+          y < kMaxAbsCoordinate_m)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Cell index along one axis, or false when it would not fit 32 bits (a query point that
+// wandered far away; it has no neighbours anyway).
+bool cell_of(double v_m, double cell_m, std::int64_t& out) {
+  const double c = std::floor(v_m / cell_m);
+  if (!(c > -2.0e9 && c < 2.0e9)) return false;
+  out = static_cast<std::int64_t>(c);
+  return true;
+}
+
+}  // namespace
+
+bool Icp2dOptions::valid() const {
+  const bool finite_eps = translation_epsilon_m >= 0.0 && translation_epsilon_m < kInfinity &&
+                          rotation_epsilon_rad >= 0.0 && rotation_epsilon_rad < kInfinity;
+  return max_iterations >= 1U && max_correspondence_m >= 1.0e-3 && max_correspondence_m <= 1.0e3 &&
+         min_correspondence_m > 0.0 && min_correspondence_m <= max_correspondence_m && shrink_factor > 0.0 &&
+         shrink_factor <= 1.0 && finite_eps && min_pairs >= 2U;
+}
+
+const char* to_string(Icp2dResult::Status status) {
+  switch (status) {
+    case Icp2dResult::Status::kConverged: return "converged";
+    case Icp2dResult::Status::kMaxIterations: return "max iterations reached";
+    case Icp2dResult::Status::kInsufficientOverlap: return "insufficient overlap";
+    case Icp2dResult::Status::kTooFewPoints: return "too few points";
+    case Icp2dResult::Status::kTooManyPoints: return "too many points";
+    case Icp2dResult::Status::kInvalidInput: return "invalid input";
+    case Icp2dResult::Status::kInvalidOptions: return "invalid options";
+  }
+  return "unknown";
+}
+
+std::uint32_t Icp2d::bucket_of(std::int64_t cx, std::int64_t cy) const {
+  // Multiplicative mixing of the two 32-bit cell indices (any fixed mix will do; the
+  // chain walk checks the exact cell).
+  std::uint32_t h = static_cast<std::uint32_t>(cx) * 0x9E3779B1U;
+  h ^= static_cast<std::uint32_t>(cy) * 0x85EBCA77U;
+  h ^= h >> 15U;
+  h *= 0xC2B2AE3DU;
+  h ^= h >> 13U;
+  return h & (capacity::kIcpHashBuckets - 1U);
+}
+
+void Icp2d::build_index(const Point2* target, std::uint32_t count, double cell_m) {
+  cell_m_ = cell_m;
+  for (std::uint32_t& head : heads_) head = kNone;
+  // Inserted from the highest index down so that every chain lists indices ascending.
+  for (std::uint32_t k = count; k > 0U; --k) {
+    const std::uint32_t i = k - 1U;
+    std::int64_t cx = 0;
+    std::int64_t cy = 0;
+    // Cannot fail: |coordinate| < 1e6 and cell_m >= 1e-3 (checked before).
+    (void)cell_of(target[i].x_m, cell_m, cx);
+    (void)cell_of(target[i].y_m, cell_m, cy);
+    cell_x_[i] = static_cast<std::int32_t>(cx);
+    cell_y_[i] = static_cast<std::int32_t>(cy);
+    const std::uint32_t b = bucket_of(cx, cy);
+    next_[i] = heads_[b];
+    heads_[b] = i;
+  }
+}
+
+std::uint32_t Icp2d::nearest(const Point2* target, double x_m, double y_m, double max_d2, double& out_d2) const {
+  std::int64_t cx = 0;
+  std::int64_t cy = 0;
+  if (!cell_of(x_m, cell_m_, cx) || !cell_of(y_m, cell_m_, cy)) return kNone;
+  std::uint32_t best = kNone;
+  double best_d2 = max_d2;
+  for (std::int64_t dy = -1; dy <= 1; ++dy) {
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      const std::int64_t qx = cx + dx;
+      const std::int64_t qy = cy + dy;
+      for (std::uint32_t i = heads_[bucket_of(qx, qy)]; i != kNone; i = next_[i]) {
+        if (cell_x_[i] != qx || cell_y_[i] != qy) continue;  // hash collision
+        const double ex = target[i].x_m - x_m;
+        const double ey = target[i].y_m - y_m;
+        const double d2 = ex * ex + ey * ey;
+        if (d2 < best_d2 || (d2 == best_d2 && (best == kNone || i < best))) {
+          best = i;
+          best_d2 = d2;
+        }
+      }
+    }
+  }
+  out_d2 = best_d2;
+  return best;
+}
+
+Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const Point2* source,
+                         std::size_t source_count, const Pose2& initial_guess, const Icp2dOptions& options) {
+  ++match_count_;
+  Icp2dResult r;
+  r.transform = initial_guess;
+  r.mean_nn_error_m = kInfinity;
+  r.rms_nn_error_m = kInfinity;
+  auto fail = [&](Icp2dResult::Status s) {
+    r.status = s;
+    r.converged = false;
+    ++failed_match_count_;
+    return r;
+  };
+  if (!options.valid()) return fail(Icp2dResult::Status::kInvalidOptions);
+  if ((target == nullptr && target_count > 0U) || (source == nullptr && source_count > 0U)) {
+    return fail(Icp2dResult::Status::kInvalidInput);
+  }
+  if (target_count > capacity::kMaxIcpPoints || source_count > capacity::kMaxIcpPoints) {
+    return fail(Icp2dResult::Status::kTooManyPoints);
+  }
+  if (target_count < options.min_pairs || source_count < options.min_pairs) {
+    return fail(Icp2dResult::Status::kTooFewPoints);
+  }
+  if (!coordinates_ok(target, target_count) || !coordinates_ok(source, source_count)) {
+    return fail(Icp2dResult::Status::kInvalidInput);
+  }
+  if (!(initial_guess.x_m > -kMaxAbsCoordinate_m && initial_guess.x_m < kMaxAbsCoordinate_m &&
+        initial_guess.y_m > -kMaxAbsCoordinate_m && initial_guess.y_m < kMaxAbsCoordinate_m &&
+        initial_guess.heading_rad > -1.0e3 && initial_guess.heading_rad < 1.0e3)) {
+    return fail(Icp2dResult::Status::kInvalidInput);
+  }
+  r.transform.heading_rad = normalize_angle_rad(initial_guess.heading_rad);
+
+  const auto n_target = static_cast<std::uint32_t>(target_count);
+  const auto n_source = static_cast<std::uint32_t>(source_count);
+  build_index(target, n_target, options.max_correspondence_m);
+
+  Pose2 t = r.transform;
+  double reject_m = options.max_correspondence_m;
+  for (std::uint32_t iter = 1U; iter <= options.max_iterations; ++iter) {
+    const double c = det::cos(t.heading_rad);
+    const double s = det::sin(t.heading_rad);
+    const double max_d2 = reject_m * reject_m;
+    // Pairing pass, accumulating the centroids on the way.
+    std::uint32_t n_pairs = 0U;
+    double sum_px = 0.0, sum_py = 0.0, sum_qx = 0.0, sum_qy = 0.0;
+    for (std::uint32_t i = 0; i < n_source; ++i) {
+      const double px = t.x_m + c * source[i].x_m - s * source[i].y_m;
+      const double py = t.y_m + s * source[i].x_m + c * source[i].y_m;
+      double d2 = 0.0;
+      const std::uint32_t j = nearest(target, px, py, max_d2, d2);
+      if (j == kNone) continue;
+      pairs_[n_pairs] = Pair{i, j};
+      ++n_pairs;
+      sum_px += px;
+      sum_py += py;
+      sum_qx += target[j].x_m;
+      sum_qy += target[j].y_m;
+    }
+    if (n_pairs < options.min_pairs) {
+      r.transform = t;
+      r.iterations = iter;
+      r.matched_pairs = n_pairs;
+      r.overlap_fraction = static_cast<double>(n_pairs) / static_cast<double>(n_source);
+      return fail(Icp2dResult::Status::kInsufficientOverlap);
+    }
+    const double inv_n = 1.0 / static_cast<double>(n_pairs);
+    const double mpx = sum_px * inv_n, mpy = sum_py * inv_n;
+    const double mqx = sum_qx * inv_n, mqy = sum_qy * inv_n;
+    // Centred cross-covariance; the optimal rotation is atan2(Σ p×q, Σ p·q).
+    double sum_dot = 0.0;
+    double sum_cross = 0.0;
+    for (std::uint32_t k = 0; k < n_pairs; ++k) {
+      const Point2& sp = source[pairs_[k].source];
+      const Point2& tq = target[pairs_[k].target];
+      const double px = (t.x_m + c * sp.x_m - s * sp.y_m) - mpx;
+      const double py = (t.y_m + s * sp.x_m + c * sp.y_m) - mpy;
+      const double qx = tq.x_m - mqx;
+      const double qy = tq.y_m - mqy;
+      sum_dot += px * qx + py * qy;
+      sum_cross += px * qy - py * qx;
+    }
+    const double dtheta = det::atan2(sum_cross, sum_dot);
+    const double dc = det::cos(dtheta);
+    const double ds = det::sin(dtheta);
+    const Pose2 delta{mqx - (dc * mpx - ds * mpy), mqy - (ds * mpx + dc * mpy), dtheta};
+    t = delta.compose(t);
+    r.iterations = iter;
+    const double step2 = delta.x_m * delta.x_m + delta.y_m * delta.y_m;
+    const double abs_dtheta = dtheta < 0.0 ? -dtheta : dtheta;
+    if (step2 <= options.translation_epsilon_m * options.translation_epsilon_m &&
+        abs_dtheta <= options.rotation_epsilon_rad) {
+      r.converged = true;
+      break;
+    }
+    const double shrunk = reject_m * options.shrink_factor;
+    reject_m = shrunk > options.min_correspondence_m ? shrunk : options.min_correspondence_m;
+  }
+
+  // Final pass: the nearest-neighbour error of the final transform.
+  r.transform = t;
+  const double c = det::cos(t.heading_rad);
+  const double s = det::sin(t.heading_rad);
+  const double max_d2 = reject_m * reject_m;
+  std::uint32_t matched = 0U;
+  double sum_d = 0.0;
+  double sum_d2 = 0.0;
+  for (std::uint32_t i = 0; i < n_source; ++i) {
+    const double px = t.x_m + c * source[i].x_m - s * source[i].y_m;
+    const double py = t.y_m + s * source[i].x_m + c * source[i].y_m;
+    double d2 = 0.0;
+    if (nearest(target, px, py, max_d2, d2) == kNone) continue;
+    ++matched;
+    sum_d += det::sqrt(d2);
+    sum_d2 += d2;
+  }
+  r.matched_pairs = matched;
+  r.overlap_fraction = static_cast<double>(matched) / static_cast<double>(n_source);
+  if (matched < options.min_pairs) {
+    r.converged = false;
+    return fail(Icp2dResult::Status::kInsufficientOverlap);
+  }
+  r.mean_nn_error_m = sum_d / static_cast<double>(matched);
+  r.rms_nn_error_m = det::sqrt(sum_d2 / static_cast<double>(matched));
+  r.status = r.converged ? Icp2dResult::Status::kConverged : Icp2dResult::Status::kMaxIterations;
+  return r;
+}
+
+}  // namespace sdpslam

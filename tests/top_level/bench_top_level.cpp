@@ -1,0 +1,110 @@
+// Timing of the top-level building blocks: ICP between two 500-point sets and
+// free-space skeleton extraction on a 200×200 patch. Prints figures; build Release.
+//   bench_top_level [repetitions]
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "sdpslam/core/arena.h"
+#include "sdpslam/core/free_space_skeleton.h"
+#include "sdpslam/core/icp2d.h"
+#include "top_level_fixtures.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+sdpslam::Icp2d g_icp;
+sdpslam::Point2 g_scene[sdpslam::capacity::kMaxIcpPoints];
+sdpslam::Point2 g_target[500];
+sdpslam::Point2 g_source[500];
+sdpslam::CellState g_cells[200U * 200U];
+sdpslam::Point2 g_points[1024];
+alignas(16) unsigned char g_buffer[1U << 20U];
+
+double micros(Clock::duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
+
+// Four 80×80 rooms around a cross of 20-cell corridors, doors into the corridors.
+void office_patch() {
+  using sdpslam::CellState;
+  using sdpslam::test::rect;
+  sdpslam::test::fill(g_cells, 200U, 200U, CellState::kOccupied);
+  rect(g_cells, 200U, 200U, 0, 90, 200, 110, CellState::kFree);  // horizontal corridor
+  rect(g_cells, 200U, 200U, 90, 0, 110, 200, CellState::kFree);  // vertical corridor
+  const int rooms[4][2] = {{5, 5}, {115, 5}, {5, 115}, {115, 115}};
+  for (const auto& r : rooms) {
+    rect(g_cells, 200U, 200U, r[0], r[1], r[0] + 80, r[1] + 80, CellState::kFree);
+  }
+  rect(g_cells, 200U, 200U, 40, 85, 50, 90, CellState::kFree);    // doors
+  rect(g_cells, 200U, 200U, 150, 110, 160, 115, CellState::kFree);
+  rect(g_cells, 200U, 200U, 85, 150, 90, 160, CellState::kFree);
+  rect(g_cells, 200U, 200U, 110, 40, 115, 50, CellState::kFree);
+  rect(g_cells, 200U, 200U, 0, 0, 200, 3, CellState::kUnknown);  // unexplored strip
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int reps = argc > 1 ? std::atoi(argv[1]) : 200;
+  if (reps < 1) {
+    std::fprintf(stderr, "bench_top_level: repetitions must be >= 1\n");
+    return 2;
+  }
+  // ICP: 500 scene points, source = noisy copy moved by (0.2 m, -0.1 m, 5 deg).
+  const std::size_t scene = sdpslam::test::structured_scene(g_scene, sdpslam::capacity::kMaxIcpPoints, 0.0240);
+  if (scene < 500U) {
+    std::fprintf(stderr, "bench_top_level: scene has only %zu points\n", scene);
+    return 1;
+  }
+  for (std::size_t i = 0; i < 500U; ++i) g_target[i] = g_scene[i * scene / 500U];
+  const sdpslam::Pose2 truth{0.2, -0.1, 5.0 * 3.14159265358979323846 / 180.0};
+  sdpslam::test::transform_points(truth.inverse(), g_target, g_source, 500U);
+  sdpslam::test::SplitMix64 rng(1U);
+  for (auto& p : g_source) {
+    p.x_m += 0.01 * rng.normal();
+    p.y_m += 0.01 * rng.normal();
+  }
+  sdpslam::Icp2dOptions icp_options;
+  icp_options.max_correspondence_m = 1.0;
+  double icp_total_us = 0.0, icp_min_us = 1e30;
+  sdpslam::Icp2dResult r;
+  for (int i = 0; i < reps; ++i) {
+    const auto t0 = Clock::now();
+    r = g_icp.match(g_target, 500U, g_source, 500U, sdpslam::Pose2{}, icp_options);
+    const double us = micros(Clock::now() - t0);
+    icp_total_us += us;
+    icp_min_us = us < icp_min_us ? us : icp_min_us;
+  }
+  std::printf("icp2d 500x500 points: mean %.1f us, min %.1f us per match (%d runs); %u iterations, "
+              "status %s, mean NN error %.4f m, error vs truth (%.4f m, %.4f m, %.4f rad)\n",
+              icp_total_us / reps, icp_min_us, reps, r.iterations, sdpslam::to_string(r.status), r.mean_nn_error_m,
+              r.transform.x_m - truth.x_m, r.transform.y_m - truth.y_m, r.transform.heading_rad - truth.heading_rad);
+
+  // Skeleton of a 200×200 office patch at 5 cm.
+  sdpslam::Arena arena(g_buffer, sizeof g_buffer);
+  sdpslam::FreeSpaceSkeleton skeleton;
+  if (!skeleton.init(arena, 200U, 200U)) {
+    std::fprintf(stderr, "bench_top_level: skeleton init failed\n");
+    return 1;
+  }
+  office_patch();
+  sdpslam::GridPatchView view;
+  view.width = 200U;
+  view.height = 200U;
+  view.resolution_m = 0.05;
+  view.cells = g_cells;
+  const int sk_reps = reps / 4 > 0 ? reps / 4 : 1;
+  double sk_total_us = 0.0, sk_min_us = 1e30;
+  sdpslam::SkeletonResult s;
+  for (int i = 0; i < sk_reps; ++i) {
+    const auto t0 = Clock::now();
+    s = skeleton.extract(view, sdpslam::SkeletonOptions{}, g_points, 1024U);
+    const double us = micros(Clock::now() - t0);
+    sk_total_us += us;
+    sk_min_us = us < sk_min_us ? us : sk_min_us;
+  }
+  std::printf("free_space_skeleton 200x200 cells: mean %.1f us, min %.1f us per patch (%d runs); "
+              "%u ridge cells, %u points, arena %zu bytes\n",
+              sk_total_us / sk_reps, sk_min_us, sk_reps, s.ridge_cell_count, s.point_count, arena.used_bytes());
+  return 0;
+}
