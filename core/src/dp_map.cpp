@@ -163,8 +163,16 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   o->node = particle;
   o->value = value;
   o->location = (slot << (2U * kSideLog2)) | c;
-  o->next_in_cell = tile.head[c];
-  tile.head[c] = e;
+  // Keep descendants before ancestors: a leaf goes first; an inner node goes after the
+  // last entry of any of its descendants.
+  std::uint32_t* link = &tile.head[c];
+  if (tree_->child_count(particle) > 0U) {
+    for (std::uint32_t* l = link; *l != kNone; l = &obs_[*l].next_in_cell) {
+      if (tree_->is_ancestor_or_self(particle, obs_[*l].node)) link = &obs_[*l].next_in_cell;
+    }
+  }
+  o->next_in_cell = *link;
+  *link = e;
   o->next_in_node = node_head_[particle];
   node_head_[particle] = e;
   ++tile.count;
@@ -216,6 +224,19 @@ void DpMap::on_node_merged(NodeId parent, NodeId child) {
     return;
   }
   std::uint32_t e = node_head_[parent];
+  if (node_head_[child] == kNone) {
+    // Common case (the child is a fresh particle): nothing to shadow, relabel only.
+    if (e == kNone) return;
+    std::uint32_t last = e;
+    for (std::uint32_t x = e; x != kNone; x = obs_[x].next_in_node) {
+      obs_[x].node = child;
+      last = x;
+    }
+    node_head_[child] = e;
+    obs_[last].next_in_node = kNone;
+    node_head_[parent] = kNone;
+    return;
+  }
   while (e != kNone) {
     Observation& o = obs_[e];
     const std::uint32_t next = o.next_in_node;
@@ -320,6 +341,7 @@ bool DpMap::invariants_hold() const {
         if (o.location != ((slot << (2U * kSideLog2)) | c) || !tree_->contains(o.node)) return false;
         for (std::uint32_t f = o.next_in_cell; f != kNone; f = obs_[f].next_in_cell) {
           if (obs_[f].node == o.node) return false;
+          if (tree_->is_ancestor_or_self(o.node, obs_[f].node)) return false;  // order
         }
       }
     }

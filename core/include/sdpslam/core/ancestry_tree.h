@@ -71,6 +71,16 @@ class PoseSink {
 };
 
 class AncestryTree {
+ private:
+  // Hot data for ancestor queries, indexed by NodeId. A node is labelled iff
+  // anchor == its own id; a node added since the last prune has anchor = the nearest
+  // labelled ancestor.
+  struct Label {
+    std::uint32_t pre = 0U;
+    std::uint32_t post = 0U;
+    std::uint32_t depth = 0U;
+    NodeId anchor = kNoNode;
+  };
  public:
   AncestryTree() = default;
   AncestryTree(const AncestryTree&) = delete;
@@ -133,6 +143,32 @@ class AncestryTree {
     return provisional_is_ancestor(ancestor, descendant);
   }
 
+  // Hot-loop form of is_ancestor_or_self for many candidate ancestors of one live
+  // descendant (DpMap lookups): the descendant's anchor interval is read once.
+  // Preconditions (unchecked): `descendant` and every queried `ancestor` are live.
+  class DescendantQuery {
+   public:
+    DescendantQuery(const AncestryTree& tree, NodeId descendant)
+        : tree_(tree), labels_(tree.labels_), descendant_(descendant) {
+      const Label& anchor = labels_[labels_[descendant].anchor];
+      pre_ = anchor.pre;
+      post_ = anchor.post;
+    }
+    bool has_ancestor_or_self(NodeId ancestor) const {
+      const Label& a = labels_[ancestor];
+      if (a.anchor == ancestor) return a.pre <= pre_ && post_ <= a.post;
+      return ancestor == descendant_ || tree_.provisional_is_ancestor(ancestor, descendant_);
+    }
+    std::uint32_t depth(NodeId live) const { return labels_[live].depth; }
+
+   private:
+    const AncestryTree& tree_;
+    const Label* labels_;
+    NodeId descendant_;
+    std::uint32_t pre_ = 0U;
+    std::uint32_t post_ = 0U;
+  };
+
   // ---- path entries ------------------------------------------------------------------
   // Appends a pose to `node`'s own path (callers append in time order). False iff
   // `node` is dead (misuse_count() bumps) or the path-entry pool is exhausted: the
@@ -194,15 +230,6 @@ class AncestryTree {
     std::uint32_t path_tail = kNoNode;  // newest own pose
     std::uint32_t path_count = 0U;
     bool active = true;
-  };
-  // Hot data for ancestor queries, indexed by NodeId. A node is labelled iff
-  // anchor == its own id; a node added since the last prune has anchor = the nearest
-  // labelled ancestor.
-  struct Label {
-    std::uint32_t pre = 0U;
-    std::uint32_t post = 0U;
-    std::uint32_t depth = 0U;
-    NodeId anchor = kNoNode;
   };
   struct PathEntry {
     std::int64_t stamp_us = 0;

@@ -114,7 +114,8 @@ class DpMap final : public TreeListener {
   // The observation of `particle`'s deepest ancestor-or-self that has one in cell
   // (ix, iy). False (and *out untouched) iff none has one, the cell is outside the map,
   // or `particle` is dead. Cost: tile table → cell head → scan of that cell's list with
-  // an O(1) ancestor test per entry; no walk up the tree.
+  // an O(1) ancestor test per entry, stopping at the first ancestor-or-self (lists keep
+  // descendants first); no walk up the tree.
   bool lookup(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation* out) const {
     if (!in_bounds(ix, iy)) return false;
     const std::uint32_t tile = tile_table_[tile_index(ix, iy)];
@@ -124,7 +125,9 @@ class DpMap final : public TreeListener {
 
   // Sets `particle`'s own observation of cell (ix, iy) to `value`: in place if it has
   // one there, else a new entry in the cell's and the node's lists (it then shadows the
-  // ancestors' for `particle` and its descendants only). Returns false iff the update is
+  // ancestors' for `particle` and its descendants only). A new entry goes to the head
+  // of the cell list when `particle` is a leaf (the filter's case), else after its
+  // descendants' entries, so that lookups can stop at the first ancestor found. Returns false iff the update is
   // dropped — the degraded path, after which the map is unchanged and consistent:
   // out of the area (out_of_bounds_count), a tile is needed and none is free
   // (tile_oom_count), an observation is needed and none is free (observation_oom_count),
@@ -176,7 +179,8 @@ class DpMap final : public TreeListener {
 
   // Full self-check, O(capacity): pool invariants; every observation is in exactly one
   // cell list and one node list, and they agree on its node and cell; no node has two
-  // observations in one cell; every node with observations is live in the tree; the
+  // observations in one cell and no entry follows an entry of one of its ancestors
+  // (what lets lookups stop early); every node with observations is live in the tree; the
   // tile table and tile back-references agree; each tile's count equals its entries
   // and no tile in use is empty; list lengths add up to the pool counts.
   bool invariants_hold() const;
@@ -207,28 +211,21 @@ class DpMap final : public TreeListener {
     return ((static_cast<std::uint32_t>(iy) & kSideMask) << kSideLog2) | (static_cast<std::uint32_t>(ix) & kSideMask);
   }
 
-  // Deepest ancestor-or-self of `particle` among the list starting at `first`.
+  // Deepest ancestor-or-self of `particle` among the list starting at `first`. Cell
+  // lists keep every node's entry before its ancestors' entries (see update()), so the
+  // first ancestor-or-self found is the deepest one.
   bool resolve(NodeId particle, std::uint32_t first, CellObservation* out) const {
     if (!tree_->contains(particle)) return false;
-    std::uint32_t best = kNone;
-    std::uint32_t best_depth = 0U;
+    // Entries of live nodes only (invariant), so the unchecked query is safe.
+    const AncestryTree::DescendantQuery query(*tree_, particle);
     for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
       const Observation& o = obs_[e];
-      if (o.node == particle) {
+      if (o.node == particle || query.has_ancestor_or_self(o.node)) {
         *out = o.value;
         return true;
       }
-      if (tree_->is_ancestor_or_self(o.node, particle)) {
-        const std::uint32_t d = tree_->depth(o.node);
-        if (best == kNone || d > best_depth) {
-          best = e;
-          best_depth = d;
-        }
-      }
     }
-    if (best == kNone) return false;
-    *out = obs_[best].value;
-    return true;
+    return false;
   }
   void unlink_from_cell(std::uint32_t e);
   void release_observation(std::uint32_t e);
