@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "can_test_support.h"
+#include "sdpslam/drivers/can_wheel_encoders.h"
 #include "sdpslam/drivers/canopen_encoder_pair.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/drivers/odrive_encoder_pair.h"
@@ -384,4 +385,77 @@ TEST(ODriveEncoderPair, other_commands_and_nodes_are_unexpected) {
   LONGS_EQUAL(2, enc.stats().unexpected_frames);
   LONGS_EQUAL(1, enc.stats().decode_errors);
   CHECK_FALSE(enc.latest().left.has_sample);
+}
+
+TEST_GROUP(CanWheelEncoders){};
+
+TEST(CanWheelEncoders, protocol_names_parse_and_unknown_is_refused) {
+  EncoderProtocol p = EncoderProtocol::kODrive;
+  CHECK_TRUE(parse_encoder_protocol("canopen", p));
+  CHECK(p == EncoderProtocol::kCanOpen);
+  CHECK_TRUE(parse_encoder_protocol("odrive", p));
+  CHECK(p == EncoderProtocol::kODrive);
+  CHECK_FALSE(parse_encoder_protocol("vesc", p));
+  CHECK(p == EncoderProtocol::kODrive);
+}
+
+TEST(CanWheelEncoders, canopen_filters_pass_only_our_objects) {
+  CanWheelEncoderConfig cfg;  // CANopen nodes 5 and 6
+  SocketCanOptions o;
+  o.kernel_timestamps = false;
+  CHECK_TRUE(add_receive_filters(cfg, o));
+  LONGS_EQUAL(6, o.filter_count);
+  test::FakeClock clock;
+  test::SeqPacketPair pair;
+  SocketCanBus bus(SocketCanBus::AdoptFd{pair.take_local()}, o, clock);
+  const std::uint8_t b[4] = {1, 0, 0, 0};
+  pair.peer_send(hal::CanFrame::standard(0x187, b, 4));  // node 7: not ours
+  hal::CanFrame rtr;
+  rtr.id = 0x185 | hal::CanFrame::kRtrFlag;  // an RTR is not a position
+  pair.peer_send(rtr);
+  pair.peer_send(hal::CanFrame::standard(0x185, b, 4));
+  pair.peer_send(hal::CanFrame::standard(0x706, b, 1));
+  hal::CanFrame got;
+  LONGS_EQUAL(1, bus.receive(got));
+  LONGS_EQUAL(0x185, got.id);
+  LONGS_EQUAL(1, bus.receive(got));
+  LONGS_EQUAL(0x706, got.id);
+  LONGS_EQUAL(2, bus.stats().rx_filtered);
+}
+
+TEST(CanWheelEncoders, filters_that_do_not_fit_are_refused_whole) {
+  CanWheelEncoderConfig cfg;
+  SocketCanOptions o;
+  o.filter_count = SocketCanOptions::kMaxFilters - 5;
+  CHECK_FALSE(add_receive_filters(cfg, o));
+  LONGS_EQUAL(SocketCanOptions::kMaxFilters - 5, o.filter_count);
+}
+
+TEST(CanWheelEncoders, odrive_selected_by_config_reads_estimates) {
+  CanWheelEncoderConfig cfg;
+  parse_encoder_protocol("odrive", cfg.protocol);
+  cfg.odrive.left_node = 1;
+  cfg.odrive.right_node = 2;
+  SocketCanOptions o;
+  o.kernel_timestamps = false;
+  CHECK_TRUE(add_receive_filters(cfg, o));
+  LONGS_EQUAL(2, o.filter_count);
+  test::FakeClock clock;
+  test::SeqPacketPair pair;
+  SocketCanBus bus(SocketCanBus::AdoptFd{pair.take_local()}, o, clock);
+  CanWheelEncoders enc(bus, clock, cfg);
+  CHECK(enc.canopen() == nullptr);
+  LONGS_EQUAL(1, enc.start());
+  hal::CanFrame f;
+  odrive::make_encoder_estimates(1, {1.5f, -2.0f}, f);
+  pair.peer_send(f);
+  odrive::make_encoder_estimates(2, {2.0f, 0.0f}, f);
+  pair.peer_send(f);
+  odrive::make_encoder_estimates(3, {9.0f, 0.0f}, f);  // filtered out by the bus
+  pair.peer_send(f);
+  LONGS_EQUAL(2, enc.update());
+  LONGS_EQUAL(12288, enc.latest().left.raw_count);
+  LONGS_EQUAL(16384, enc.latest().right.raw_count);
+  LONGS_EQUAL(1, bus.stats().rx_filtered);
+  LONGS_EQUAL(0, enc.odrive()->stats().unexpected_frames);
 }
