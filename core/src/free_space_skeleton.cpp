@@ -249,16 +249,21 @@ SkeletonResult FreeSpaceSkeleton::extract(const GridPatchView& patch, const Skel
   const double min_clear_cells = options.min_clearance_m / res;
   const double min_clear_sq = min_clear_cells * min_clear_cells;
   const double cos_limit = det::cos(options.min_ridge_angle_rad);
+  const bool obtuse_only = cos_limit <= 0.0;
   const auto wide_enough = [&](std::uint32_t mx, std::uint32_t my, std::uint32_t fa, std::uint32_t fb) {
     if (static_cast<double>(sq_dist_[at(mx, my)]) < min_clear_sq) return false;
-    const auto ax = static_cast<double>(feature_x(fa) - static_cast<std::int64_t>(mx));
-    const auto ay = static_cast<double>(feature_y(fa) - static_cast<std::int64_t>(my));
-    const auto bx = static_cast<double>(feature_x(fb) - static_cast<std::int64_t>(mx));
-    const auto by = static_cast<double>(feature_y(fb) - static_cast<std::int64_t>(my));
-    const double na = ax * ax + ay * ay;
-    const double nb = bx * bx + by * by;
+    const std::int64_t ax = feature_x(fa) - static_cast<std::int64_t>(mx);
+    const std::int64_t ay = feature_y(fa) - static_cast<std::int64_t>(my);
+    const std::int64_t bx = feature_x(fb) - static_cast<std::int64_t>(mx);
+    const std::int64_t by = feature_y(fb) - static_cast<std::int64_t>(my);
+    const std::int64_t dot = ax * bx + ay * by;
+    // Exact integer early-out for the common case (neighbours along a wall): a limit of
+    // 90° or more needs a non-positive dot product.
+    if (obtuse_only && dot > 0) return false;
+    const auto na = static_cast<double>(ax * ax + ay * ay);
+    const auto nb = static_cast<double>(bx * bx + by * by);
     if (na == 0.0 || nb == 0.0) return false;
-    return ax * bx + ay * by <= cos_limit * det::sqrt(na * nb);
+    return static_cast<double>(dot) <= cos_limit * det::sqrt(na * nb);
   };
   const auto consider = [&](std::uint32_t px, std::uint32_t py, std::uint32_t qx, std::uint32_t qy) {
     if ((mark_[at(px, py)] & kClassMask) != kClassFree || (mark_[at(qx, qy)] & kClassMask) != kClassFree) return;

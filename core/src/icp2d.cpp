@@ -39,9 +39,10 @@ bool cell_of(double v_m, double cell_m, std::int64_t& out) {
 bool Icp2dOptions::valid() const {
   const bool finite_eps = translation_epsilon_m >= 0.0 && translation_epsilon_m < kInfinity &&
                           rotation_epsilon_rad >= 0.0 && rotation_epsilon_rad < kInfinity;
-  return max_iterations >= 1U && max_correspondence_m >= 1.0e-3 && max_correspondence_m <= 1.0e3 &&
-         min_correspondence_m > 0.0 && min_correspondence_m <= max_correspondence_m && shrink_factor > 0.0 &&
-         shrink_factor <= 1.0 && finite_eps && min_pairs >= 2U;
+  return max_iterations >= 1U && max_correspondence_m <= 1.0e3 && min_correspondence_m > 0.0 &&
+         min_correspondence_m <= max_correspondence_m && nn_cell_m >= 1.0e-3 && nn_cell_m <= 1.0e3 &&
+         max_correspondence_m <= 1000.0 * nn_cell_m && shrink_factor > 0.0 && shrink_factor <= 1.0 && finite_eps &&
+         min_pairs >= 2U;
 }
 
 const char* to_string(Icp2dResult::Status status) {
@@ -76,7 +77,7 @@ void Icp2d::build_index(const Point2* target, std::uint32_t count, double cell_m
     const std::uint32_t i = k - 1U;
     std::int64_t cx = 0;
     std::int64_t cy = 0;
-    // Cannot fail: |coordinate| < 1e6 and cell_m >= 1e-3 (checked before).
+    // Cannot fail: |coordinate| < 1e6 and nn_cell_m >= 1e-3 (checked before).
     (void)cell_of(target[i].x_m, cell_m, cx);
     (void)cell_of(target[i].y_m, cell_m, cy);
     cell_x_[i] = static_cast<std::int32_t>(cx);
@@ -87,26 +88,41 @@ void Icp2d::build_index(const Point2* target, std::uint32_t count, double cell_m
   }
 }
 
-std::uint32_t Icp2d::nearest(const Point2* target, double x_m, double y_m, double max_d2, double& out_d2) const {
+void Icp2d::scan_cell(const Point2* target, std::int64_t qx, std::int64_t qy, double x_m, double y_m,
+                      std::uint32_t& best, double& best_d2) const {
+  for (std::uint32_t i = heads_[bucket_of(qx, qy)]; i != kNone; i = next_[i]) {
+    if (cell_x_[i] != qx || cell_y_[i] != qy) continue;  // hash collision
+    const double ex = target[i].x_m - x_m;
+    const double ey = target[i].y_m - y_m;
+    const double d2 = ex * ex + ey * ey;
+    // Ties go to the lowest index, whatever order the cells are visited in.
+    if (d2 < best_d2 || (d2 == best_d2 && (best == kNone || i < best))) {
+      best = i;
+      best_d2 = d2;
+    }
+  }
+}
+
+std::uint32_t Icp2d::nearest(const Point2* target, double x_m, double y_m, double max_d, double& out_d2) const {
   std::int64_t cx = 0;
   std::int64_t cy = 0;
   if (!cell_of(x_m, cell_m_, cx) || !cell_of(y_m, cell_m_, cy)) return kNone;
   std::uint32_t best = kNone;
-  double best_d2 = max_d2;
-  for (std::int64_t dy = -1; dy <= 1; ++dy) {
-    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-      const std::int64_t qx = cx + dx;
-      const std::int64_t qy = cy + dy;
-      for (std::uint32_t i = heads_[bucket_of(qx, qy)]; i != kNone; i = next_[i]) {
-        if (cell_x_[i] != qx || cell_y_[i] != qy) continue;  // hash collision
-        const double ex = target[i].x_m - x_m;
-        const double ey = target[i].y_m - y_m;
-        const double d2 = ex * ex + ey * ey;
-        if (d2 < best_d2 || (d2 == best_d2 && (best == kNone || i < best))) {
-          best = i;
-          best_d2 = d2;
-        }
-      }
+  double best_d2 = max_d * max_d;
+  // Ring k holds the cells at Chebyshev distance k from the query's cell; every point in
+  // it is at least (k - 1) cells away, so ring rings + 1 is beyond max_d.
+  const auto rings = static_cast<std::int64_t>(max_d / cell_m_) + 1;
+  scan_cell(target, cx, cy, x_m, y_m, best, best_d2);
+  for (std::int64_t k = 1; k <= rings; ++k) {
+    const double reach = static_cast<double>(k - 1) * cell_m_;
+    if (best != kNone && best_d2 < reach * reach) break;  // strict: keeps tie-breaking exact
+    for (std::int64_t d = -k; d <= k; ++d) {
+      scan_cell(target, cx + d, cy - k, x_m, y_m, best, best_d2);
+      scan_cell(target, cx + d, cy + k, x_m, y_m, best, best_d2);
+    }
+    for (std::int64_t d = -k + 1; d <= k - 1; ++d) {
+      scan_cell(target, cx - k, cy + d, x_m, y_m, best, best_d2);
+      scan_cell(target, cx + k, cy + d, x_m, y_m, best, best_d2);
     }
   }
   out_d2 = best_d2;
@@ -148,14 +164,13 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
 
   const auto n_target = static_cast<std::uint32_t>(target_count);
   const auto n_source = static_cast<std::uint32_t>(source_count);
-  build_index(target, n_target, options.max_correspondence_m);
+  build_index(target, n_target, options.nn_cell_m);
 
   Pose2 t = r.transform;
   double reject_m = options.max_correspondence_m;
   for (std::uint32_t iter = 1U; iter <= options.max_iterations; ++iter) {
     const double c = det::cos(t.heading_rad);
     const double s = det::sin(t.heading_rad);
-    const double max_d2 = reject_m * reject_m;
     // Pairing pass, accumulating the centroids on the way.
     std::uint32_t n_pairs = 0U;
     double sum_px = 0.0, sum_py = 0.0, sum_qx = 0.0, sum_qy = 0.0;
@@ -163,7 +178,7 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
       const double px = t.x_m + c * source[i].x_m - s * source[i].y_m;
       const double py = t.y_m + s * source[i].x_m + c * source[i].y_m;
       double d2 = 0.0;
-      const std::uint32_t j = nearest(target, px, py, max_d2, d2);
+      const std::uint32_t j = nearest(target, px, py, reject_m, d2);
       if (j == kNone) continue;
       pairs_[n_pairs] = Pair{i, j};
       ++n_pairs;
@@ -216,7 +231,6 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
   r.transform = t;
   const double c = det::cos(t.heading_rad);
   const double s = det::sin(t.heading_rad);
-  const double max_d2 = reject_m * reject_m;
   std::uint32_t matched = 0U;
   double sum_d = 0.0;
   double sum_d2 = 0.0;
@@ -224,7 +238,7 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
     const double px = t.x_m + c * source[i].x_m - s * source[i].y_m;
     const double py = t.y_m + s * source[i].x_m + c * source[i].y_m;
     double d2 = 0.0;
-    if (nearest(target, px, py, max_d2, d2) == kNone) continue;
+    if (nearest(target, px, py, reject_m, d2) == kNone) continue;
     ++matched;
     sum_d += det::sqrt(d2);
     sum_d2 += d2;

@@ -199,8 +199,10 @@ TEST(Icp2d, out_of_range_options_are_refused) {
   o.min_correspondence_m = 2.0 * o.max_correspondence_m;
   CHECK_FALSE(o.valid());
   o = Icp2dOptions{};
-  o.max_correspondence_m = 1e-4;  // hash cells that small would overflow their indices
-  o.min_correspondence_m = 1e-5;
+  o.nn_cell_m = 1e-4;  // hash cells that small would overflow their indices
+  CHECK_FALSE(o.valid());
+  o = Icp2dOptions{};
+  o.max_correspondence_m = 200.0;  // 2000 rings of 0.1 m cells: unbounded search cost
   CHECK_FALSE(o.valid());
   CHECK_TRUE(Icp2dOptions{}.valid());
 }
@@ -251,6 +253,44 @@ TEST(Icp2d, one_iteration_budget_reports_max_iterations_with_a_usable_estimate) 
   CHECK_FALSE(r.converged);
   LONGS_EQUAL(1, r.iterations);
   CHECK(std::isfinite(r.mean_nn_error_m));
+}
+
+TEST(Icp2d, nearest_neighbour_error_equals_brute_force_for_any_cell_size) {
+  // Random clouds: the grid-hash ring search must find exactly the brute-force nearest
+  // neighbour within the gate, whatever the cell size.
+  sdpslam::test::SplitMix64 rng(42U);
+  const std::size_t n = 600U;
+  for (std::size_t i = 0; i < n; ++i) {
+    g_target[i] = Point2{8.0 * rng.uniform() - 4.0, 6.0 * rng.uniform() - 3.0};
+    g_source[i] = Point2{8.0 * rng.uniform() - 4.0, 6.0 * rng.uniform() - 3.0};
+  }
+  for (double cell_m : {0.01, 0.07, 0.3, 1.0, 5.0}) {
+    Icp2dOptions o;
+    o.max_iterations = 1U;
+    o.max_correspondence_m = 0.25;
+    o.min_correspondence_m = 0.25;
+    o.nn_cell_m = cell_m;
+    const Icp2dResult r = g_icp.match(g_target, n, g_source, n, Pose2{}, o);
+    CHECK_TRUE(r.usable());
+    const double c = std::cos(r.transform.heading_rad);
+    const double s = std::sin(r.transform.heading_rad);
+    double sum = 0.0;
+    std::uint32_t matched = 0U;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double px = r.transform.x_m + c * g_source[i].x_m - s * g_source[i].y_m;
+      const double py = r.transform.y_m + s * g_source[i].x_m + c * g_source[i].y_m;
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < n; ++j) {
+        best = std::fmin(best, std::hypot(g_target[j].x_m - px, g_target[j].y_m - py));
+      }
+      if (best <= 0.25) {
+        sum += best;
+        ++matched;
+      }
+    }
+    LONGS_EQUAL(matched, r.matched_pairs);
+    DOUBLES_EQUAL(sum / matched, r.mean_nn_error_m, 1e-9);
+  }
 }
 
 TEST(Icp2d, same_input_gives_bit_identical_results_across_objects) {
