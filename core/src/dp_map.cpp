@@ -204,7 +204,7 @@ void DpMap::release_observation(std::uint32_t e) {
   obs_pool_.release(&obs_[e]);
 }
 
-void DpMap::on_node_removed(NodeId node) {
+void DpMap::remove_node(NodeId node) {
   if (tree_ == nullptr || node >= node_capacity_) {
     ++misuse_count_;
     return;
@@ -218,7 +218,7 @@ void DpMap::on_node_removed(NodeId node) {
   node_head_[node] = kNone;
 }
 
-void DpMap::on_node_merged(NodeId parent, NodeId child) {
+void DpMap::merge_node(NodeId parent, NodeId child) {
   if (tree_ == nullptr || parent >= node_capacity_ || child >= node_capacity_ || parent == child) {
     ++misuse_count_;
     return;

@@ -157,11 +157,13 @@ class DpMap final : public TreeListener {
   std::uint32_t observation_count(NodeId node) const;
 
   // ---- TreeListener (called by AncestryTree::prune) ----------------------------------
+  // Defined inline (no key function), so that the vtable and type info are emitted
+  // where the map is used: the core is built without RTTI, tests with UBSan's vptr check.
   // Frees every observation `node` owns (and tiles left empty).
-  void on_node_removed(NodeId node) override;
+  void on_node_removed(NodeId node) override { remove_node(node); }
   // Gives `parent`'s observations to `child`, except in cells where `child` has its own
   // (newer) one: there the parent's is freed.
-  void on_node_merged(NodeId parent, NodeId child) override;
+  void on_node_merged(NodeId parent, NodeId child) override { merge_node(parent, child); }
 
   // ---- accounting --------------------------------------------------------------------
   std::uint32_t tiles_used() const { return tiles_pool_.size(); }
@@ -227,6 +229,8 @@ class DpMap final : public TreeListener {
     }
     return false;
   }
+  void remove_node(NodeId node);
+  void merge_node(NodeId parent, NodeId child);
   void unlink_from_cell(std::uint32_t e);
   void release_observation(std::uint32_t e);
   std::uint32_t find_in_cell(std::uint32_t first, NodeId node) const;
