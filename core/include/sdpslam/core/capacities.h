@@ -88,3 +88,17 @@ static_assert(kMaxPgsLevels >= 2U && kMaxPgsLevels <= 65536U, "kMaxPgsLevels out
 inline constexpr std::uint32_t kMaxPgsNodesPerLevel = kMaxBottomParticles;
 
 }  // namespace sdpslam::capacity
+
+// ---- Bottom-level DP-SLAM particle filter (dpslam_filter.h) ------------------------
+namespace sdpslam::capacity {
+
+// Upper bounds DpSlamOptions::validate() enforces on its per-particle provisioning.
+// Ancestry nodes per particle: kAncestryNodesPerParticle is enough in normal operation;
+// more only buys headroom, fewer is allowed to test the degraded path.
+inline constexpr std::uint32_t kDpSlamMaxNodesPerParticle = 16U;
+// Uncommitted poses per particle: the depth (in processed scans) back to the common
+// ancestor of all particles; beyond it poses are dropped and counted.
+inline constexpr std::uint32_t kDpSlamMaxPathEntriesPerParticle = 1000000U;
+static_assert(kDpSlamMaxNodesPerParticle >= kAncestryNodesPerParticle, "nodes per particle bound below the tree's need");
+
+}  // namespace sdpslam::capacity

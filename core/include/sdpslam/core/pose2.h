@@ -4,19 +4,14 @@
 // Composition follows the usual convention: a.compose(b) is pose b expressed in the
 // frame of a, mapped to the frame a is expressed in (a ⊕ b). between(a, b) = a⁻¹ ⊕ b,
 // the displacement used by odometry deltas and by the relations metric (Kümmerle 2009).
-#include <cmath>
+// Trigonometry goes through det_math.h so that results are bit-identical across
+// platforms (see there why).
+#include "sdpslam/core/det_math.h"
 
 namespace sdpslam {
 
 // Wraps an angle to (-pi, pi].
-inline double normalize_angle_rad(double a) {
-  constexpr double kPi = 3.14159265358979323846;
-  constexpr double kTwoPi = 2.0 * kPi;
-  a = std::fmod(a, kTwoPi);
-  if (a <= -kPi) a += kTwoPi;
-  if (a > kPi) a -= kTwoPi;
-  return a;
-}
+inline double normalize_angle_rad(double a) { return det::wrap_angle(a); }
 
 struct Pose2 {
   double x_m = 0.0;
@@ -25,21 +20,21 @@ struct Pose2 {
 
   // this ⊕ b
   Pose2 compose(const Pose2& b) const {
-    const double c = std::cos(heading_rad);
-    const double s = std::sin(heading_rad);
+    const double c = det::cos(heading_rad);
+    const double s = det::sin(heading_rad);
     return Pose2{x_m + c * b.x_m - s * b.y_m, y_m + s * b.x_m + c * b.y_m,
                  normalize_angle_rad(heading_rad + b.heading_rad)};
   }
   // this⁻¹
   Pose2 inverse() const {
-    const double c = std::cos(heading_rad);
-    const double s = std::sin(heading_rad);
+    const double c = det::cos(heading_rad);
+    const double s = det::sin(heading_rad);
     return Pose2{-c * x_m - s * y_m, s * x_m - c * y_m, normalize_angle_rad(-heading_rad)};
   }
   // Maps a point given in this pose's frame into the parent frame.
   void transform_point(double px_m, double py_m, double& out_x_m, double& out_y_m) const {
-    const double c = std::cos(heading_rad);
-    const double s = std::sin(heading_rad);
+    const double c = det::cos(heading_rad);
+    const double s = det::sin(heading_rad);
     out_x_m = x_m + c * px_m - s * py_m;
     out_y_m = y_m + s * px_m + c * py_m;
   }

@@ -1,0 +1,97 @@
+#pragma once
+// Observation model of the bottom-level filter, evaluated through the distributed
+// particle map (paper §II-A; Eliazar & Parr, DP-SLAM 2.0, ICRA 2004 §3 "laser
+// penetration model").
+//
+// Choice: DP-SLAM's stopping-probability (penetration) model rather than a log-odds
+// beam model, because it is what the DP map's per-node (hits, misses) counts measure:
+// the chance that a beam entering a cell stops in it is estimated as
+//   p_stop(h, m) = (h + prior_hits) / (h + m + prior_hits + prior_misses)
+// (a Beta-prior estimate of DP-SLAM's opacity), and a cell nobody has seen has
+// p_stop = unknown_stop_probability. A beam of measured range r is scored by the chance
+// that it stops at cell k, having passed cells before it, times the Gaussian chance of
+// reading r from that cell, plus a floor for readings the model cannot explain:
+//   L = floor + Σ_k p_stop(k) · Π_{j<k} (1 − p_stop(j)) · N(r − d_k; σ)·cell
+// The sum runs over the cells the beam crosses within ±window of r (DDA/Bresenham on
+// cells), which is where nearly all of the mass is; cells before the window are taken
+// as passed (their misses are what the map update writes). This keeps the hot path at
+// ~2·window/cell lookups per beam.
+//
+// Hot path: no transcendental calls per beam. p_stop comes from a LUT over (hits,
+// misses) clamped to 0..kStopLutSide−1 (larger counts are scaled down keeping their
+// ratio); the Gaussian from a LUT over |error| in 1/16 cell steps; beam directions are
+// rotated with one sin/cos per particle; the product over beams is kept as a mantissa
+// and a binary exponent (exact bit operations), so a scan costs one det::log.
+//
+// Map update (all beams, every surviving particle): a miss for every cell from the
+// laser to the end point, a hit at the end point (DP-SLAM's d/h counts). Beams longer
+// than max_update_range_m mark misses up to that range and no hit; no-return beams mark
+// misses up to no_return_free_m (0 = not at all). A dropped update (map pool exhausted,
+// outside the area) is counted by DpMap and reported; the map stays consistent.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/pose2.h"
+#include "sdpslam/core/range_scan.h"
+
+namespace sdpslam {
+
+struct BeamModelOptions {
+  double sigma_hit_m = 0.05;             // range error standard deviation
+  double window_m = 0.15;                // half-width of the evaluated stretch around r
+  double prior_hits = 0.5;               // Beta prior of the stopping probability
+  double prior_misses = 1.0;
+  double unknown_stop_probability = 0.05;  // p_stop of a cell nobody has observed
+  double floor_likelihood = 0.02;        // added to every beam's likelihood (outliers)
+  std::uint32_t weight_beam_stride = 2;  // every k-th beam weights particles
+  double max_update_range_m = 15.0;      // beams beyond: misses up to here, no hit
+  double no_return_free_m = 5.0;         // no-return beams: misses up to here
+  double likelihood_temperature = 1.0;   // log-likelihood is divided by this (≥ 1 softens)
+};
+
+// Per-scan quantities shared by all particles (computed once per scan, not per particle).
+struct ScanRays {
+  std::uint32_t count = 0U;
+  float range_m[capacity::kMaxBeams] = {};
+  double cos_a[capacity::kMaxBeams] = {};  // beam direction in the laser frame
+  double sin_a[capacity::kMaxBeams] = {};
+  std::uint8_t kind[capacity::kMaxBeams] = {};  // RangeScan::Beam
+  Pose2 laser_in_base;
+};
+void prepare_rays(const RangeScan& scan, ScanRays* out);
+
+class BeamModel {
+ public:
+  static constexpr std::uint32_t kStopLutSide = 64U;
+  static constexpr std::uint32_t kGaussSubsteps = 16U;
+  static constexpr std::uint32_t kMaxGaussEntries = 4096U;
+
+  // Builds the tables for `options` and a grid of `resolution_m`. Returns false (and
+  // writes a reason) iff an option is out of range.
+  bool init(const BeamModelOptions& options, double resolution_m);
+
+  // log p(scan | pose, particle's map), divided by likelihood_temperature. Costs
+  // ~(beams / stride) · (2·window / cell) map lookups.
+  double log_likelihood(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const;
+
+  // Writes the scan into `particle`'s map. Returns the number of cell updates the map
+  // dropped (0 normally).
+  std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const;
+
+  // Stopping probability of a cell with these counts (the LUT the hot path uses).
+  double stop_probability(const CellObservation& c) const;
+  const BeamModelOptions& options() const { return options_; }
+
+ private:
+  double gauss_mass(double abs_error_m) const;
+
+  BeamModelOptions options_{};
+  double resolution_m_ = 0.05;
+  double inv_gauss_step_ = 0.0;
+  std::uint32_t gauss_entries_ = 0U;
+  double stop_lut_[kStopLutSide * kStopLutSide] = {};
+  double gauss_lut_[kMaxGaussEntries] = {};
+};
+
+}  // namespace sdpslam

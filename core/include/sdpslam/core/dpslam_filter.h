@@ -1,0 +1,149 @@
+#pragma once
+// The bottom-level DP-SLAM particle filter (paper §II-A; Algorithm 1 line 3, "DP-SLAM
+// update"); on its own, the DP-SLAM baseline of §IV.
+//
+// Each processed scan:
+//   1. propagate: every particle samples a pose from the odometry motion model
+//      (motion_model.h) around its previous pose;
+//   2. weight: log p(scan | pose, particle's map) through the DP map (beam_model.h);
+//   3. resample (low variance) iff N_eff < resample_neff_ratio · N (resampling.h);
+//   4. map update: every particle that survives resampling writes the scan into its own
+//      ancestry node's observations (hits at end points, misses along rays) and records
+//      its pose on that node's path; then every drawn particle becomes a new child node
+//      (duplicates of one particle become siblings that inherit the same map);
+//   5. prune/merge the ancestry tree (the DP map follows through TreeListener) and
+//      drain the poses every particle agrees on to the PoseSink.
+// A scan is processed only once the odometry has moved update_min_travel_m or turned
+// update_min_rotation_rad since the last processed scan; other scans get the best
+// particle's pose composed with the odometry since (StepResult::pose).
+//
+// Memory: init() carves everything from the caller's Arena (required_arena_bytes());
+// process() never touches the heap. The object itself holds ~60 KiB of per-scan tables:
+// keep it in static storage or on the heap at init, not on a small stack.
+//
+// Exhaustion is counted, never fatal (see Stats):
+//  - node pool full: a drawn particle that cannot get a child node continues on its
+//    parent's node (kept active); its later map updates are then shared with its
+//    siblings. Counted in node_fallback_count.
+//  - observation/tile pool full: the cell update is dropped (map stays consistent, the
+//    particle's map just lacks that evidence). Counted in map_updates_dropped.
+//  - path entries full: the pose is not recorded on the tree (the trajectory has a gap
+//    the caller fills from odometry). Counted by the tree's path_oom_count.
+// Deterministic: same options, seed and input → bit-identical poses.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/arena.h"
+#include "sdpslam/core/beam_model.h"
+#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/dpslam_options.h"
+#include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/range_scan.h"
+#include "sdpslam/core/rng.h"
+
+namespace sdpslam {
+
+struct StepResult {
+  enum class Status : std::uint8_t {
+    kProcessed,        // propagated, weighted, (maybe) resampled, map updated
+    kSkippedNoMotion,  // below the update thresholds: pose from odometry
+    kNotInitialised,   // init() was not called or failed
+  };
+  Status status = Status::kNotInitialised;
+  Pose2 pose;                     // best estimate of the robot pose at this scan
+  bool resampled = false;
+  double effective_sample_size = 0.0;
+  std::uint32_t map_updates_dropped = 0U;  // this step
+  std::uint32_t poses_committed = 0U;      // this step
+};
+
+struct DpSlamStats {
+  std::uint64_t scans = 0U;
+  std::uint64_t processed = 0U;
+  std::uint64_t resamplings = 0U;
+  std::uint64_t map_updates_dropped = 0U;
+  std::uint64_t node_fallback_count = 0U;
+  std::uint64_t degenerate_weight_count = 0U;  // all weights -inf/NaN: kept uniform
+};
+
+class DpSlamFilter {
+ public:
+  DpSlamFilter() = default;
+  DpSlamFilter(const DpSlamFilter&) = delete;
+  DpSlamFilter& operator=(const DpSlamFilter&) = delete;
+
+  // Arena bytes init() needs for `options` (0 iff the options are invalid).
+  static std::size_t required_arena_bytes(const DpSlamOptions& options);
+
+  // Validates options and carves every pool from `arena`. False iff the options are
+  // invalid or the arena is too small (why() then says which). Call once.
+  bool init(const DpSlamOptions& options, Arena& arena, std::uint64_t seed);
+  const char* why() const { return why_; }
+
+  // Feeds one laser scan with the odometry pose at its time. The first scan initialises
+  // the particles at the odometry pose (so the estimate lives in the odometry frame).
+  StepResult process(const OdometrySample& odom, const RangeScan& scan);
+
+  // Receives poses every particle agrees on (committed). May be null. Not owned.
+  void set_pose_sink(PoseSink* sink) { sink_ = sink; }
+
+  // ---- the best particle -------------------------------------------------------------
+  // Highest-weight particle of the last processed step (its node is a current leaf).
+  NodeId best_node() const { return particle_count_ > 0U ? particles_[best_index_].node : kNoNode; }
+  Pose2 best_pose() const { return particle_count_ > 0U ? particles_[best_index_].pose : Pose2{}; }
+  // Calls f(stamp_us, pose) for the best particle's uncommitted poses, oldest first
+  // (committed poses went to the sink).
+  template <class F>
+  void for_each_best_pose(F&& f) const {
+    if (best_node() != kNoNode) tree_.for_each_pose_from_root(best_node(), f);
+  }
+  // Occupancy probability the filter believes for a cell observation (for map output).
+  double occupancy(const CellObservation& c) const { return beam_.stop_probability(c); }
+
+  const DpMap& map() const { return map_; }
+  const AncestryTree& tree() const { return tree_; }
+  const DpSlamOptions& options() const { return options_; }
+  const DpSlamStats& stats() const { return stats_; }
+  std::uint32_t particle_count() const { return particle_count_; }
+  Pose2 particle_pose(std::uint32_t i) const { return i < particle_count_ ? particles_[i].pose : Pose2{}; }
+  NodeId particle_node(std::uint32_t i) const { return i < particle_count_ ? particles_[i].node : kNoNode; }
+  bool initialised() const { return initialised_; }
+
+ private:
+  struct Particle {
+    NodeId node = kNoNode;
+    Pose2 pose;
+    double log_weight = 0.0;
+  };
+
+  void first_scan(const OdometrySample& odom, const RangeScan& scan, StepResult* result);
+
+  DpSlamOptions options_{};
+  AncestryTree tree_;
+  DpMap map_;
+  BeamModel beam_;
+  MotionModel motion_;
+  Rng rng_;
+  PoseSink* sink_ = nullptr;
+  DpSlamStats stats_{};
+  ScanRays rays_{};
+
+  Particle* particles_ = nullptr;      // current generation
+  Particle* next_ = nullptr;           // next generation (swapped)
+  Pose2* proposed_ = nullptr;          // sampled pose per particle
+  double* log_w_ = nullptr;
+  double* w_ = nullptr;
+  std::uint32_t* drawn_ = nullptr;     // resampled indices
+  std::uint32_t* counts_ = nullptr;    // children per particle
+  std::uint32_t particle_count_ = 0U;
+  std::uint32_t best_index_ = 0U;
+
+  bool initialised_ = false;
+  bool started_ = false;
+  OdometrySample last_odom_{};         // odometry at the last processed scan
+  Pose2 last_best_pose_{};             // best pose at the last processed scan
+  char why_[160] = {};
+};
+
+}  // namespace sdpslam

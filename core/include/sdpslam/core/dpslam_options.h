@@ -1,0 +1,46 @@
+#pragma once
+// Options of the bottom-level DP-SLAM filter (paper §II-A, Algorithm 1 line 3), validated
+// once (Cartographer style): validate() range-checks every field and names the first
+// bad one with its allowed range. Every field has a key in tools/slam/default.ini.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/beam_model.h"
+#include "sdpslam/core/capacities.h"
+#include "sdpslam/core/motion_model.h"
+
+namespace sdpslam {
+
+struct DpSlamOptions {
+  // [filter]
+  std::uint32_t particle_count = 30;        // 1 .. capacity::kMaxBottomParticles
+  double resample_neff_ratio = 0.5;         // resample iff N_eff < ratio · N; (0, 1]
+  double update_min_travel_m = 0.2;         // process a scan only after this much travel
+  double update_min_rotation_rad = 0.15;    // ... or this much rotation
+  // [motion]
+  MotionModelOptions motion;
+  // [observation]
+  BeamModelOptions beam;
+  // [map]: a fixed area centred on the first pose
+  double map_resolution_m = 0.05;
+  double map_width_m = 120.0;
+  double map_height_m = 120.0;
+  std::uint32_t map_tile_capacity = 0U;     // 0 = every tile of the area
+  std::uint32_t map_observations_base = 2000000U;        // shared (old, committed) map
+  std::uint32_t map_observations_per_particle = 20000U;  // each branch's recent cells
+  // [capacity]
+  std::uint32_t ancestry_nodes_per_particle = capacity::kAncestryNodesPerParticle;
+  std::uint32_t path_entries_per_particle = 64U;         // uncommitted poses per particle
+
+  // True iff every field is in range; otherwise writes "field: value out of range
+  // [lo, hi]" (truncated to n bytes, NUL-terminated) into `why` (may be null).
+  bool validate(char* why, std::size_t n) const;
+
+  // Derived capacities (valid options only).
+  std::uint32_t node_capacity() const { return particle_count * ancestry_nodes_per_particle; }
+  std::uint32_t path_entry_capacity() const { return particle_count * path_entries_per_particle; }
+  std::uint32_t observation_capacity() const;
+  std::uint32_t tile_capacity() const;
+};
+
+}  // namespace sdpslam

@@ -1,0 +1,205 @@
+#include "sdpslam/core/beam_model.h"
+
+#include <cstring>
+
+#include "sdpslam/core/det_math.h"
+
+namespace sdpslam {
+namespace {
+
+// floor() to a cell index, clamped far outside any map so that int32 never overflows.
+std::int32_t floor_cell(double v) {
+  if (!(v > -1.0e9)) return -1000000000;
+  if (!(v < 1.0e9)) return 1000000000;
+  auto i = static_cast<std::int64_t>(v);
+  if (static_cast<double>(i) > v) --i;
+  return static_cast<std::int32_t>(i);
+}
+
+// Integer Bresenham from (x0, y0) to (x1, y1) inclusive; f(ix, iy, last) returns false
+// to stop early.
+template <class F>
+void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1, F&& f) {
+  const std::int64_t dx = x1 >= x0 ? static_cast<std::int64_t>(x1) - x0 : static_cast<std::int64_t>(x0) - x1;
+  const std::int64_t dy = y1 >= y0 ? static_cast<std::int64_t>(y1) - y0 : static_cast<std::int64_t>(y0) - y1;
+  const std::int32_t sx = x0 < x1 ? 1 : -1;
+  const std::int32_t sy = y0 < y1 ? 1 : -1;
+  std::int64_t err = dx - dy;
+  std::int32_t x = x0;
+  std::int32_t y = y0;
+  // A beam is at most a few thousand cells long; the bound guards against garbage input.
+  for (std::int64_t guard = 0; guard <= dx + dy + 1; ++guard) {
+    const bool last = (x == x1 && y == y1);
+    if (!f(x, y, last) || last) return;
+    const std::int64_t e2 = 2 * err;
+    if (e2 > -dy) {
+      err -= dy;
+      x += sx;
+    }
+    if (e2 < dx) {
+      err += dx;
+      y += sy;
+    }
+  }
+}
+
+inline double mantissa_and_exponent(double v, std::int64_t* exponent) {
+  // v > 0 and normal: returns v scaled into [1, 2) and adds the removed power of two.
+  std::uint64_t u;
+  std::memcpy(&u, &v, sizeof u);
+  const auto e = static_cast<std::int64_t>((u >> 52) & 0x7FFU);
+  if (e == 0 || e == 0x7FF) return v;  // subnormal/inf: leave (cannot happen with floor > 0)
+  *exponent += e - 1023;
+  u = (u & 0x000FFFFFFFFFFFFFULL) | 0x3FF0000000000000ULL;
+  std::memcpy(&v, &u, sizeof v);
+  return v;
+}
+
+struct LaserFrame {
+  double x_m, y_m, c, s;
+};
+LaserFrame laser_frame(const ScanRays& rays, const Pose2& robot) {
+  const Pose2 laser = robot.compose(rays.laser_in_base);
+  return LaserFrame{laser.x_m, laser.y_m, det::cos(laser.heading_rad), det::sin(laser.heading_rad)};
+}
+
+}  // namespace
+
+void prepare_rays(const RangeScan& scan, ScanRays* out) {
+  const std::uint32_t n = scan.beam_count <= capacity::kMaxBeams ? scan.beam_count : capacity::kMaxBeams;
+  out->count = n;
+  out->laser_in_base = scan.geometry.laser_in_base;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double a = static_cast<double>(scan.beam_angle_rad(i));
+    out->cos_a[i] = det::cos(a);
+    out->sin_a[i] = det::sin(a);
+    out->range_m[i] = scan.ranges_m[i];
+    out->kind[i] = static_cast<std::uint8_t>(scan.classify(i));
+  }
+}
+
+bool BeamModel::init(const BeamModelOptions& options, double resolution_m) {
+  if (!(resolution_m > 0.0) || !(options.sigma_hit_m > 0.0) || !(options.window_m > 0.0) ||
+      !(options.prior_hits > 0.0) || !(options.prior_misses > 0.0) ||
+      !(options.unknown_stop_probability > 0.0 && options.unknown_stop_probability < 1.0) ||
+      !(options.floor_likelihood > 0.0) || options.weight_beam_stride == 0U ||
+      !(options.likelihood_temperature >= 1.0)) {
+    return false;
+  }
+  options_ = options;
+  resolution_m_ = resolution_m;
+  for (std::uint32_t h = 0; h < kStopLutSide; ++h) {
+    for (std::uint32_t m = 0; m < kStopLutSide; ++m) {
+      stop_lut_[h * kStopLutSide + m] = (static_cast<double>(h) + options.prior_hits) /
+                                        (static_cast<double>(h + m) + options.prior_hits + options.prior_misses);
+    }
+  }
+  const double step = resolution_m / static_cast<double>(kGaussSubsteps);
+  inv_gauss_step_ = 1.0 / step;
+  const double span = options.window_m + 2.0 * resolution_m;
+  double n = span / step + 2.0;
+  if (n > static_cast<double>(kMaxGaussEntries)) n = static_cast<double>(kMaxGaussEntries);
+  gauss_entries_ = static_cast<std::uint32_t>(n);
+  const double norm = resolution_m / (options.sigma_hit_m * det::sqrt(2.0 * det::kPi));
+  for (std::uint32_t i = 0; i < gauss_entries_; ++i) {
+    const double e = static_cast<double>(i) * step / options.sigma_hit_m;
+    gauss_lut_[i] = norm * det::exp(-0.5 * e * e);
+  }
+  return true;
+}
+
+double BeamModel::stop_probability(const CellObservation& c) const {
+  std::uint32_t h = c.hits;
+  std::uint32_t m = c.misses;
+  if (h >= kStopLutSide || m >= kStopLutSide) {
+    const std::uint32_t big = h > m ? h : m;
+    h = h * (kStopLutSide - 1U) / big;
+    m = m * (kStopLutSide - 1U) / big;
+  }
+  return stop_lut_[h * kStopLutSide + m];
+}
+
+double BeamModel::gauss_mass(double abs_error_m) const {
+  const double idx = abs_error_m * inv_gauss_step_ + 0.5;
+  if (!(idx < static_cast<double>(gauss_entries_))) return 0.0;
+  return gauss_lut_[static_cast<std::uint32_t>(idx)];
+}
+
+double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
+  const LaserFrame lf = laser_frame(rays, robot);
+  const double res = resolution_m_;
+  const double inv_res = 1.0 / res;
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  const double w = options_.window_m;
+  const double unknown = options_.unknown_stop_probability;
+  double prod = 1.0;
+  std::int64_t exponent = 0;
+  for (std::uint32_t b = 0; b < rays.count; b += options_.weight_beam_stride) {
+    if (rays.kind[b] != static_cast<std::uint8_t>(RangeScan::Beam::kReturn)) continue;
+    const double r = static_cast<double>(rays.range_m[b]);
+    const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
+    const double dy = lf.s * rays.cos_a[b] + lf.c * rays.sin_a[b];
+    const double d0 = r > w ? r - w : 0.0;
+    const double d1 = r + w;
+    const std::int32_t x0 = floor_cell((lf.x_m + d0 * dx - ox) * inv_res);
+    const std::int32_t y0 = floor_cell((lf.y_m + d0 * dy - oy) * inv_res);
+    const std::int32_t x1 = floor_cell((lf.x_m + d1 * dx - ox) * inv_res);
+    const std::int32_t y1 = floor_cell((lf.y_m + d1 * dy - oy) * inv_res);
+    double reach = 1.0;
+    double like = 0.0;
+    trace_cells(x0, y0, x1, y1, [&](std::int32_t ix, std::int32_t iy, bool) {
+      CellObservation obs;
+      const double p = map.lookup(particle, ix, iy, &obs) ? stop_probability(obs) : unknown;
+      // Distance along the beam of the cell centre's projection.
+      const double cx = ox + (static_cast<double>(ix) + 0.5) * res - lf.x_m;
+      const double cy = oy + (static_cast<double>(iy) + 0.5) * res - lf.y_m;
+      const double d = cx * dx + cy * dy;
+      const double e = r > d ? r - d : d - r;
+      like += reach * p * gauss_mass(e);
+      reach *= 1.0 - p;
+      return reach > 1e-6;
+    });
+    prod = mantissa_and_exponent(prod * (like + options_.floor_likelihood), &exponent);
+  }
+  const double ll = det::log(prod) + static_cast<double>(exponent) * det::kLn2;
+  return ll / options_.likelihood_temperature;
+}
+
+std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
+  const LaserFrame lf = laser_frame(rays, robot);
+  const double inv_res = 1.0 / resolution_m_;
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  const std::int32_t lx = floor_cell((lf.x_m - ox) * inv_res);
+  const std::int32_t ly = floor_cell((lf.y_m - oy) * inv_res);
+  std::uint32_t dropped = 0U;
+  for (std::uint32_t b = 0; b < rays.count; ++b) {
+    double end_m;
+    bool hit;
+    const auto kind = static_cast<RangeScan::Beam>(rays.kind[b]);
+    if (kind == RangeScan::Beam::kReturn) {
+      const double r = static_cast<double>(rays.range_m[b]);
+      hit = r <= options_.max_update_range_m;
+      end_m = hit ? r : options_.max_update_range_m;
+    } else if (kind == RangeScan::Beam::kNoReturn && options_.no_return_free_m > 0.0) {
+      hit = false;
+      end_m = options_.no_return_free_m < options_.max_update_range_m ? options_.no_return_free_m
+                                                                         : options_.max_update_range_m;
+    } else {
+      continue;
+    }
+    const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
+    const double dy = lf.s * rays.cos_a[b] + lf.c * rays.sin_a[b];
+    const std::int32_t ex = floor_cell((lf.x_m + end_m * dx - ox) * inv_res);
+    const std::int32_t ey = floor_cell((lf.y_m + end_m * dy - oy) * inv_res);
+    trace_cells(lx, ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
+      const bool ok = (last && hit) ? map.add(particle, ix, iy, 1U, 0U) : map.add(particle, ix, iy, 0U, 1U);
+      if (!ok) ++dropped;
+      return true;
+    });
+  }
+  return dropped;
+}
+
+}  // namespace sdpslam

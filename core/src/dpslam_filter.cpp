@@ -1,0 +1,232 @@
+#include "sdpslam/core/dpslam_filter.h"
+
+#include <cstdio>
+
+#include "sdpslam/core/det_math.h"
+#include "sdpslam/core/resampling.h"
+
+namespace sdpslam {
+namespace {
+
+class NullSink final : public PoseSink {
+ public:
+  void on_committed(std::int64_t, const Pose2&) override {}
+};
+
+constexpr std::size_t kSlack = 64U;  // alignment padding per carved array
+
+template <typename T>
+std::size_t array_bytes(std::uint32_t n) {
+  return sizeof(T) * static_cast<std::size_t>(n) + kSlack;
+}
+
+DpMap::Options map_options(const DpSlamOptions& o) {
+  DpMap::Options m;
+  // The map frame has the first processed pose at its origin; the area is centred on it.
+  m.origin_x_m = -0.5 * o.map_width_m;
+  m.origin_y_m = -0.5 * o.map_height_m;
+  m.width_m = o.map_width_m;
+  m.height_m = o.map_height_m;
+  m.resolution_m = o.map_resolution_m;
+  m.tile_capacity = o.tile_capacity();
+  m.observation_capacity = o.observation_capacity();
+  return m;
+}
+
+}  // namespace
+
+std::size_t DpSlamFilter::required_arena_bytes(const DpSlamOptions& o) {
+  if (!o.validate(nullptr, 0U)) return 0U;
+  const std::size_t map_bytes = DpMap::required_arena_bytes(map_options(o), o.node_capacity());
+  if (map_bytes == 0U) return 0U;
+  const std::uint32_t n = o.particle_count;
+  return AncestryTree::required_arena_bytes(o.node_capacity(), o.path_entry_capacity()) + map_bytes +
+         2U * array_bytes<Particle>(n) + array_bytes<Pose2>(n) + 2U * array_bytes<double>(n) +
+         2U * array_bytes<std::uint32_t>(n) + kSlack;
+}
+
+bool DpSlamFilter::init(const DpSlamOptions& options, Arena& arena, std::uint64_t seed) {
+  initialised_ = false;
+  if (!options.validate(why_, sizeof why_)) return false;
+  const std::size_t need = required_arena_bytes(options);
+  if (need == 0U) {
+    std::snprintf(why_, sizeof why_, "map options rejected by DpMap");
+    return false;
+  }
+  if (arena.available_bytes() < need) {
+    std::snprintf(why_, sizeof why_, "arena too small: %zu bytes available, %zu needed", arena.available_bytes(),
+                  need);
+    return false;
+  }
+  options_ = options;
+  if (!tree_.init(arena, options.node_capacity(), options.path_entry_capacity())) {
+    std::snprintf(why_, sizeof why_, "ancestry tree init failed (capacity %u nodes)", options.node_capacity());
+    return false;
+  }
+  if (!map_.init(arena, map_options(options), tree_)) {
+    std::snprintf(why_, sizeof why_, "DP map init failed");
+    return false;
+  }
+  if (!beam_.init(options.beam, options.map_resolution_m)) {
+    std::snprintf(why_, sizeof why_, "observation model options rejected");
+    return false;
+  }
+  motion_ = MotionModel(options.motion);
+  const std::uint32_t n = options.particle_count;
+  particles_ = arena.allocate_array<Particle>(n);
+  next_ = arena.allocate_array<Particle>(n);
+  proposed_ = arena.allocate_array<Pose2>(n);
+  log_w_ = arena.allocate_array<double>(n);
+  w_ = arena.allocate_array<double>(n);
+  drawn_ = arena.allocate_array<std::uint32_t>(n);
+  counts_ = arena.allocate_array<std::uint32_t>(n);
+  if (particles_ == nullptr || next_ == nullptr || proposed_ == nullptr || log_w_ == nullptr || w_ == nullptr ||
+      drawn_ == nullptr || counts_ == nullptr) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving particle arrays");
+    return false;
+  }
+  particle_count_ = n;
+  rng_.reseed(seed);
+  stats_ = DpSlamStats{};
+  started_ = false;
+  best_index_ = 0U;
+  why_[0] = '\0';
+  initialised_ = true;
+  return true;
+}
+
+void DpSlamFilter::first_scan(const OdometrySample& odom, const RangeScan& scan, StepResult* result) {
+  prepare_rays(scan, &rays_);
+  const Pose2 origin{};
+  const NodeId root = tree_.create_root();
+  std::uint32_t dropped = 0U;
+  if (root != kNoNode) {
+    dropped = beam_.update_map(map_, root, rays_, origin);
+    tree_.append_pose(root, scan.stamp_us, origin);
+  }
+  for (std::uint32_t i = 0; i < particle_count_; ++i) {
+    NodeId c = root != kNoNode ? tree_.add_child(root) : kNoNode;
+    if (c == kNoNode) {
+      c = root;
+      ++stats_.node_fallback_count;
+    }
+    particles_[i] = Particle{c, origin, 0.0};
+  }
+  if (root != kNoNode && particles_[0].node != root) tree_.set_active(root, false);
+  tree_.prune(&map_);
+  NullSink null_sink;
+  result->poses_committed = tree_.drain_committed(sink_ != nullptr ? *sink_ : static_cast<PoseSink&>(null_sink));
+  started_ = true;
+  last_odom_ = odom;
+  last_best_pose_ = origin;
+  best_index_ = 0U;
+  ++stats_.processed;
+  stats_.map_updates_dropped += dropped;
+  result->status = StepResult::Status::kProcessed;
+  result->pose = origin;
+  result->map_updates_dropped = dropped;
+  result->effective_sample_size = static_cast<double>(particle_count_);
+}
+
+StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& scan) {
+  StepResult result;
+  if (!initialised_) return result;
+  ++stats_.scans;
+  if (!started_) {
+    first_scan(odom, scan, &result);
+    return result;
+  }
+  const Pose2 delta = between(last_odom_.pose, odom.pose);
+  const double travel = det::sqrt(delta.x_m * delta.x_m + delta.y_m * delta.y_m);
+  const double turn = delta.heading_rad < 0.0 ? -delta.heading_rad : delta.heading_rad;
+  if (travel < options_.update_min_travel_m && turn < options_.update_min_rotation_rad) {
+    result.status = StepResult::Status::kSkippedNoMotion;
+    result.pose = last_best_pose_.compose(delta);
+    return result;
+  }
+
+  const std::uint32_t n = particle_count_;
+  prepare_rays(scan, &rays_);
+  // 1-2. propagate and weight.
+  for (std::uint32_t i = 0; i < n; ++i) {
+    proposed_[i] = motion_.sample(particles_[i].pose, delta, rng_);
+    log_w_[i] = particles_[i].log_weight + beam_.log_likelihood(map_, particles_[i].node, rays_, proposed_[i]);
+  }
+  if (!normalize_log_weights(log_w_, n, w_)) ++stats_.degenerate_weight_count;
+  const double neff = effective_sample_size(w_, n);
+  std::uint32_t best = 0U;
+  for (std::uint32_t i = 1; i < n; ++i) {
+    if (w_[i] > w_[best]) best = i;
+  }
+  // 3. resample.
+  const bool resample = neff < options_.resample_neff_ratio * static_cast<double>(n);
+  if (resample) {
+    low_variance_resample(w_, n, rng_, drawn_);
+    ++stats_.resamplings;
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i) drawn_[i] = i;
+  }
+  for (std::uint32_t i = 0; i < n; ++i) counts_[i] = 0U;
+  for (std::uint32_t m = 0; m < n; ++m) ++counts_[drawn_[m]];
+  // 4. map update and path of every surviving particle (once per node: duplicates
+  //    become children that inherit it).
+  std::uint32_t dropped = 0U;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (counts_[i] == 0U) continue;
+    bool seen = false;  // a node shared by several particles (fallback) is updated once
+    for (std::uint32_t j = 0; j < i && !seen; ++j) {
+      seen = counts_[j] > 0U && particles_[j].node == particles_[i].node;
+    }
+    if (seen) continue;
+    dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i]);
+    tree_.append_pose(particles_[i].node, scan.stamp_us, proposed_[i]);
+  }
+  const double best_lw = log_w_[best];
+  for (std::uint32_t m = 0; m < n; ++m) {
+    const std::uint32_t i = drawn_[m];
+    NodeId c = tree_.add_child(particles_[i].node);
+    if (c == kNoNode) {
+      c = particles_[i].node;  // degraded: continue on the parent's node
+      ++stats_.node_fallback_count;
+    }
+    double lw = 0.0;
+    if (!resample) {
+      lw = log_w_[i] - best_lw;
+      if (!(lw > -1.0e300)) lw = -1.0e300;  // keep finite: -inf would never recover
+    }
+    next_[m] = Particle{c, proposed_[i], lw};
+  }
+  for (std::uint32_t i = 0; i < n; ++i) tree_.set_active(particles_[i].node, false);
+  for (std::uint32_t m = 0; m < n; ++m) {
+    if (next_[m].node == particles_[drawn_[m]].node) tree_.set_active(next_[m].node, true);
+  }
+  // 5. prune/merge, commit.
+  tree_.prune(&map_);
+  NullSink null_sink;
+  result.poses_committed = tree_.drain_committed(sink_ != nullptr ? *sink_ : static_cast<PoseSink&>(null_sink));
+
+  std::uint32_t new_best = 0U;
+  for (std::uint32_t m = 0; m < n; ++m) {
+    if (drawn_[m] == best) {
+      new_best = m;
+      break;
+    }
+  }
+  Particle* tmp = particles_;
+  particles_ = next_;
+  next_ = tmp;
+  best_index_ = new_best;
+  last_odom_ = odom;
+  last_best_pose_ = proposed_[best];
+
+  ++stats_.processed;
+  stats_.map_updates_dropped += dropped;
+  result.status = StepResult::Status::kProcessed;
+  result.pose = last_best_pose_;
+  result.resampled = resample;
+  result.effective_sample_size = neff;
+  result.map_updates_dropped = dropped;
+  return result;
+}
+
+}  // namespace sdpslam

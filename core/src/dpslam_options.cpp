@@ -1,0 +1,106 @@
+#include "sdpslam/core/dpslam_options.h"
+
+#include <cstdio>
+
+namespace sdpslam {
+namespace {
+
+struct Checker {
+  char* why;
+  std::size_t n;
+  bool ok = true;
+
+  void real(const char* field, double v, double lo, double hi) {
+    if (!ok) return;
+    if (!(v >= lo && v <= hi)) {
+      ok = false;
+      if (why != nullptr && n > 0U) std::snprintf(why, n, "%s: %g out of range [%g, %g]", field, v, lo, hi);
+    }
+  }
+  void open_low(const char* field, double v, double lo, double hi) {  // (lo, hi]
+    if (!ok) return;
+    if (!(v > lo && v <= hi)) {
+      ok = false;
+      if (why != nullptr && n > 0U) std::snprintf(why, n, "%s: %g out of range (%g, %g]", field, v, lo, hi);
+    }
+  }
+  void integer(const char* field, std::uint64_t v, std::uint64_t lo, std::uint64_t hi) {
+    if (!ok) return;
+    if (v < lo || v > hi) {
+      ok = false;
+      if (why != nullptr && n > 0U)
+        std::snprintf(why, n, "%s: %llu out of range [%llu, %llu]", field, static_cast<unsigned long long>(v),
+                      static_cast<unsigned long long>(lo), static_cast<unsigned long long>(hi));
+    }
+  }
+};
+
+std::uint64_t tiles_of_area(const DpSlamOptions& o) {
+  const double side = o.map_resolution_m * static_cast<double>(capacity::kDpTileSideCells);
+  const double tx = o.map_width_m / side + 1.0;
+  const double ty = o.map_height_m / side + 1.0;
+  return static_cast<std::uint64_t>(tx) * static_cast<std::uint64_t>(ty);
+}
+
+}  // namespace
+
+bool DpSlamOptions::validate(char* why, std::size_t n) const {
+  if (why != nullptr && n > 0U) why[0] = '\0';
+  Checker c{why, n};
+  c.integer("filter.particles", particle_count, 1U, capacity::kMaxBottomParticles);
+  c.open_low("filter.resample_neff_ratio", resample_neff_ratio, 0.0, 1.0);
+  c.real("filter.update_min_travel_m", update_min_travel_m, 0.0, 10.0);
+  c.real("filter.update_min_rotation_rad", update_min_rotation_rad, 0.0, 3.14159);
+  c.real("motion.alpha_rot_from_rot", motion.alpha_rot_from_rot, 0.0, 10.0);
+  c.real("motion.alpha_rot_from_trans", motion.alpha_rot_from_trans, 0.0, 10.0);
+  c.real("motion.alpha_trans_from_trans", motion.alpha_trans_from_trans, 0.0, 10.0);
+  c.real("motion.alpha_trans_from_rot", motion.alpha_trans_from_rot, 0.0, 10.0);
+  c.real("motion.min_sigma_trans_m", motion.min_sigma_trans_m, 0.0, 1.0);
+  c.real("motion.min_sigma_rot_rad", motion.min_sigma_rot_rad, 0.0, 1.0);
+  c.open_low("observation.sigma_hit_m", beam.sigma_hit_m, 0.0, 5.0);
+  c.open_low("observation.window_m", beam.window_m, 0.0, 5.0);
+  c.open_low("observation.prior_hits", beam.prior_hits, 0.0, 1000.0);
+  c.open_low("observation.prior_misses", beam.prior_misses, 0.0, 1000.0);
+  c.open_low("observation.unknown_stop_probability", beam.unknown_stop_probability, 0.0, 0.99);
+  c.open_low("observation.floor_likelihood", beam.floor_likelihood, 0.0, 1.0);
+  c.integer("observation.weight_beam_stride", beam.weight_beam_stride, 1U, capacity::kMaxBeams);
+  c.open_low("observation.max_update_range_m", beam.max_update_range_m, 0.0, 200.0);
+  c.real("observation.no_return_free_m", beam.no_return_free_m, 0.0, 200.0);
+  c.real("observation.likelihood_temperature", beam.likelihood_temperature, 1.0, 1000.0);
+  c.real("map.resolution_m", map_resolution_m, 0.005, 1.0);
+  c.real("map.width_m", map_width_m, 1.0, 10000.0);
+  c.real("map.height_m", map_height_m, 1.0, 10000.0);
+  if (c.ok) {
+    // The window must cover the Gaussian and at least one cell; the table must hold it.
+    c.real("observation.window_m", beam.window_m, map_resolution_m,
+           map_resolution_m * static_cast<double>(BeamModel::kMaxGaussEntries) /
+                   static_cast<double>(BeamModel::kGaussSubsteps) - 2.0 * map_resolution_m);
+    const double cells = (map_width_m / map_resolution_m) * (map_height_m / map_resolution_m);
+    c.real("map.width_m*height_m/resolution_m^2 (cells)", cells, 1.0, 4.0e9);
+  }
+  c.integer("map.tile_capacity", map_tile_capacity, 0U, capacity::kDpMaxTiles);
+  c.integer("map.observations_base", map_observations_base, 0U, 0xF0000000U);
+  c.integer("map.observations_per_particle", map_observations_per_particle, 1U, 100000000U);
+  c.integer("capacity.ancestry_nodes_per_particle", ancestry_nodes_per_particle, 1U, capacity::kDpSlamMaxNodesPerParticle);
+  c.integer("capacity.path_entries_per_particle", path_entries_per_particle, 1U, capacity::kDpSlamMaxPathEntriesPerParticle);
+  if (c.ok) {
+    const std::uint64_t obs = static_cast<std::uint64_t>(map_observations_base) +
+                              static_cast<std::uint64_t>(particle_count) * map_observations_per_particle;
+    c.integer("map.observations_base + particles*observations_per_particle", obs, 1U, 0xF0000000U);
+    c.integer("particles*capacity.path_entries_per_particle",
+              static_cast<std::uint64_t>(particle_count) * path_entries_per_particle, 1U, 0xF0000000U);
+    c.integer("map tiles (0 = whole area)", map_tile_capacity == 0U ? tiles_of_area(*this) : map_tile_capacity, 1U,
+              capacity::kDpMaxTiles);
+  }
+  return c.ok;
+}
+
+std::uint32_t DpSlamOptions::observation_capacity() const {
+  return map_observations_base + particle_count * map_observations_per_particle;
+}
+
+std::uint32_t DpSlamOptions::tile_capacity() const {
+  return map_tile_capacity != 0U ? map_tile_capacity : static_cast<std::uint32_t>(tiles_of_area(*this));
+}
+
+}  // namespace sdpslam

@@ -1,0 +1,123 @@
+// Observation model through the DP map: a scan consistent with the map scores higher
+// than the same scan from a shifted or rotated pose; map updates write hits and misses.
+#include <CppUTest/TestHarness.h>
+
+#include <memory>
+#include <vector>
+
+#include "sdpslam/core/beam_model.h"
+#include "sim_world.h"
+
+using namespace sdpslam;
+
+namespace {
+struct MapFixture {
+  std::vector<unsigned char> buffer;
+  Arena arena;
+  AncestryTree tree;
+  DpMap map;
+  BeamModel beam;
+  NodeId root = kNoNode;
+  std::unique_ptr<ScanRays> rays = std::make_unique<ScanRays>();
+  std::unique_ptr<RangeScan> scan = std::make_unique<RangeScan>();
+
+  explicit MapFixture(BeamModelOptions bo = BeamModelOptions{}) {
+    DpMap::Options mo;
+    mo.origin_x_m = -5.0;
+    mo.origin_y_m = -5.0;
+    mo.width_m = 20.0;
+    mo.height_m = 15.0;
+    mo.resolution_m = 0.05;
+    mo.tile_capacity = 2000;
+    mo.observation_capacity = 200000;
+    buffer.resize(AncestryTree::required_arena_bytes(16, 16) + DpMap::required_arena_bytes(mo, 16) + 256);
+    arena.reset(buffer.data(), buffer.size());
+    CHECK_TRUE(tree.init(arena, 16, 16));
+    CHECK_TRUE(map.init(arena, mo, tree));
+    CHECK_TRUE(beam.init(bo, 0.05));
+    root = tree.create_root();
+  }
+};
+}  // namespace
+
+TEST_GROUP(BeamModel){};
+
+TEST(BeamModel, consistent_scan_scores_higher_than_shifted_or_turned_poses) {
+  MapFixture f;
+  const auto world = test::room_world();
+  const Pose2 truth{3.0, 1.0, 0.3};
+  test::make_scan(world, truth, 0, f.scan.get());
+  prepare_rays(*f.scan, f.rays.get());
+  LONGS_EQUAL(0, f.beam.update_map(f.map, f.root, *f.rays, truth));
+  const double at_truth = f.beam.log_likelihood(f.map, f.root, *f.rays, truth);
+  for (const Pose2& off : {Pose2{0.1, 0.0, 0.0}, Pose2{0.0, -0.1, 0.0}, Pose2{0.0, 0.0, 0.05}, Pose2{0.3, 0.2, -0.1}}) {
+    const Pose2 wrong{truth.x_m + off.x_m, truth.y_m + off.y_m, truth.heading_rad + off.heading_rad};
+    const double at_wrong = f.beam.log_likelihood(f.map, f.root, *f.rays, wrong);
+    CHECK(at_truth > at_wrong + 5.0);
+  }
+}
+
+TEST(BeamModel, likelihood_grows_as_the_pose_error_shrinks) {
+  MapFixture f;
+  const auto world = test::room_world();
+  const Pose2 truth{1.0, 4.0, -1.0};
+  test::make_scan(world, truth, 0, f.scan.get());
+  prepare_rays(*f.scan, f.rays.get());
+  f.beam.update_map(f.map, f.root, *f.rays, truth);
+  double prev = -1e300;
+  for (double off : {0.4, 0.2, 0.1, 0.05, 0.0}) {
+    const double ll = f.beam.log_likelihood(f.map, f.root, *f.rays, Pose2{truth.x_m + off, truth.y_m, truth.heading_rad});
+    CHECK(ll > prev);
+    prev = ll;
+  }
+}
+
+TEST(BeamModel, update_marks_the_end_point_hit_and_the_ray_free) {
+  MapFixture f;
+  f.scan->geometry.angle_min_rad = 0.0F;
+  f.scan->geometry.angle_increment_rad = 0.01F;
+  f.scan->geometry.range_min_m = 0.1F;
+  f.scan->geometry.range_max_m = 30.0F;
+  f.scan->beam_count = 1;
+  f.scan->ranges_m[0] = 2.0F;
+  prepare_rays(*f.scan, f.rays.get());
+  f.beam.update_map(f.map, f.root, *f.rays, Pose2{0.02, 0.02, 0.0});
+  std::int32_t ix, iy;
+  CellObservation c;
+  CHECK_TRUE(f.map.world_to_cell(2.02, 0.02, &ix, &iy));
+  CHECK_TRUE(f.map.lookup(f.root, ix, iy, &c));
+  LONGS_EQUAL(1, c.hits);
+  CHECK_TRUE(f.map.world_to_cell(1.0, 0.02, &ix, &iy));
+  CHECK_TRUE(f.map.lookup(f.root, ix, iy, &c));
+  LONGS_EQUAL(0, c.hits);
+  LONGS_EQUAL(1, c.misses);
+  CHECK_TRUE(f.map.world_to_cell(2.5, 0.02, &ix, &iy));
+  CHECK_FALSE(f.map.lookup(f.root, ix, iy, &c));
+  CHECK(f.beam.stop_probability(CellObservation{10, 0}) > 0.9);
+  CHECK(f.beam.stop_probability(CellObservation{0, 10}) < 0.1);
+}
+
+TEST(BeamModel, beams_leaving_the_map_are_counted_as_dropped_not_fatal) {
+  MapFixture f;
+  f.scan->geometry.angle_min_rad = 0.0F;
+  f.scan->geometry.angle_increment_rad = 0.01F;
+  f.scan->geometry.range_min_m = 0.1F;
+  f.scan->geometry.range_max_m = 30.0F;
+  f.scan->beam_count = 1;
+  f.scan->ranges_m[0] = 14.0F;  // ends beyond x = 15 m
+  prepare_rays(*f.scan, f.rays.get());
+  CHECK(f.beam.update_map(f.map, f.root, *f.rays, Pose2{5.0, 0.0, 0.0}) > 0U);
+  CHECK(f.map.out_of_bounds_count() > 0U);
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
+TEST(BeamModel, invalid_options_are_refused) {
+  BeamModel b;
+  BeamModelOptions o;
+  o.sigma_hit_m = 0.0;
+  CHECK_FALSE(b.init(o, 0.05));
+  o = BeamModelOptions{};
+  o.weight_beam_stride = 0;
+  CHECK_FALSE(b.init(o, 0.05));
+  CHECK_TRUE(b.init(BeamModelOptions{}, 0.05));
+}
