@@ -5,6 +5,7 @@
 //   cmake -S . -B build/rel -G Ninja -DCMAKE_BUILD_TYPE=Release
 //   cmake --build build/rel --target bench_dp_map && build/rel/tests/dpslam_structures/bench_dp_map
 // Arguments: [particles=400] [steps=60] [cells_per_particle_per_step=300] [seed=1]
+//            [half_window_cells=120] (the area a scan touches around the robot)
 #include <ctime>
 #include <cstdint>
 #include <cstdio>
@@ -39,8 +40,11 @@ int main(int argc, char** argv) {
   const std::uint32_t steps = argc > 2 ? static_cast<std::uint32_t>(std::strtoul(argv[2], nullptr, 10)) : 60U;
   const std::uint32_t cells = argc > 3 ? static_cast<std::uint32_t>(std::strtoul(argv[3], nullptr, 10)) : 300U;
   const std::uint64_t seed = argc > 4 ? std::strtoull(argv[4], nullptr, 10) : 1U;
-  if (n < 2U || n > 4096U || steps < 1U || cells < 1U) {
-    std::fprintf(stderr, "usage: bench_dp_map [particles 2..4096] [steps] [cells_per_particle_per_step] [seed]\n");
+  const std::int32_t window = argc > 5 ? static_cast<std::int32_t>(std::strtol(argv[5], nullptr, 10)) : 120;
+  if (n < 2U || n > 4096U || steps < 1U || cells < 1U || window < 1 || window > 500) {
+    std::fprintf(stderr,
+                 "usage: bench_dp_map [particles 2..4096] [steps] [cells_per_particle_per_step] [seed] "
+                 "[half_window_cells 1..500]\n");
     return 2;
   }
 
@@ -71,7 +75,6 @@ int main(int argc, char** argv) {
   double t_update = 0.0, t_lookup = 0.0, t_prune = 0.0;
   std::uint64_t n_update = 0U, n_lookup = 0U, n_known = 0U, n_prune = 0U;
   const std::uint32_t warmup = steps / 4U;
-  const std::int32_t window = 120;  // cells around the robot a scan touches (6 m)
 
   for (std::uint32_t s = 0; s < steps; ++s) {
     const bool measure = s >= warmup;
@@ -98,8 +101,8 @@ int main(int argc, char** argv) {
     for (std::uint32_t k = 0; k < n; ++k) {
       tree.append_pose(current[k], static_cast<std::int64_t>(s) * 100000, sdpslam::Pose2{});
       for (std::uint32_t c = 0; c < cells; ++c) {
-        const std::int32_t ix = cx + static_cast<std::int32_t>(rng.below(2U * window)) - window;
-        const std::int32_t iy = cy + static_cast<std::int32_t>(rng.below(2U * window)) - window;
+        const std::int32_t ix = cx + static_cast<std::int32_t>(rng.below(static_cast<std::uint32_t>(2 * window))) - window;
+        const std::int32_t iy = cy + static_cast<std::int32_t>(rng.below(static_cast<std::uint32_t>(2 * window))) - window;
         map.add(current[k], ix, iy, 1U, 0U);
       }
     }
@@ -113,8 +116,8 @@ int main(int argc, char** argv) {
     sdpslam::CellObservation v;
     for (std::uint32_t k = 0; k < n; ++k) {
       for (std::uint32_t c = 0; c < 4U * cells; ++c) {
-        const std::int32_t ix = cx + 2 + static_cast<std::int32_t>(rng.below(2U * window)) - window;
-        const std::int32_t iy = cy + static_cast<std::int32_t>(rng.below(2U * window)) - window;
+        const std::int32_t ix = cx + 2 + static_cast<std::int32_t>(rng.below(static_cast<std::uint32_t>(2 * window))) - window;
+        const std::int32_t iy = cy + static_cast<std::int32_t>(rng.below(static_cast<std::uint32_t>(2 * window))) - window;
         n_known += map.lookup(current[k], ix, iy, &v) ? 1U : 0U;
       }
     }
@@ -133,7 +136,8 @@ int main(int argc, char** argv) {
       lists += e > 0U ? 1U : 0U;
     }
   }
-  std::printf("particles %u, steps %u (%u measured), cells/particle/step %u\n", n, steps, steps - warmup, cells);
+  std::printf("particles %u, steps %u (%u measured), cells/particle/step %u, window +-%d cells\n", n, steps,
+              steps - warmup, cells, window);
   std::printf("(rates per second of process CPU time)\n");
   std::printf("lookups/s        %.3g  (%llu lookups, %.1f %% known)\n", static_cast<double>(n_lookup) / t_lookup,
               static_cast<unsigned long long>(n_lookup),

@@ -299,7 +299,7 @@ TEST(AncestryTree, empty_tree_after_everything_dies) {
 // operation, the 2N−1 bound after every prune, the 3N pool never exhausted, and
 // ancestor queries equal to a parent walk.
 static void run_random_resampling(std::uint32_t n, std::uint32_t generations, std::uint64_t seed) {
-  TreeFixture f(3U * n, 4U);
+  TreeFixture f(AncestryTree::node_capacity_for(n), 4U);
   AncestryTree& t = f.tree;
   sdpslam::test::SplitMix64 rng(seed);
   std::vector<NodeId> particles{t.create_root()};

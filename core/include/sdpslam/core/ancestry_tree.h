@@ -37,6 +37,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/arena.h"
+#include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pool.h"
 #include "sdpslam/core/pose2.h"
 
@@ -86,6 +87,11 @@ class AncestryTree {
   AncestryTree(const AncestryTree&) = delete;
   AncestryTree& operator=(const AncestryTree&) = delete;
 
+  // Node capacity that add_child() can never exhaust for a filter of `particles`
+  // particles that prunes after every resampling (see "Size bound" above).
+  static constexpr std::uint32_t node_capacity_for(std::uint32_t particles) {
+    return capacity::kAncestryNodesPerParticle * particles;
+  }
   // Arena bytes init() needs for these capacities (alignment padding included).
   static std::size_t required_arena_bytes(std::uint32_t node_capacity, std::uint32_t path_entry_capacity);
 
