@@ -9,7 +9,6 @@ namespace sdpslam {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr std::uint32_t kNoFeature = 0xFFFFFFFFU;
 // Cell classes kept in mark_ (low bits) and the ridge flag.
 constexpr std::uint8_t kClassFree = 1U;
 constexpr std::uint8_t kClassObstacle = 2U;

@@ -318,6 +318,20 @@ TEST(SegmentGraph, chain_of_known_poses_composes_into_the_global_frame) {
   LONGS_EQUAL(PgsStatus::kNoLevel, g.compose_chain(choices, 6U, frames));
 }
 
+TEST(SegmentGraph, chain_around_a_square_loop_returns_to_the_start) {
+  Fixture f(options(8U, 2U));
+  SegmentGraph& g = f.graph;
+  // Each segment drives 1 m and turns left 90°: four segments go round a square, and the
+  // headings pass through +-pi (angle wrapping).
+  for (int k = 0; k < 5; ++k) add(g, 2U, Pose2{1.0, 0.0, kPi / 2.0});
+  const std::uint32_t choices[5] = {1U, 0U, 1U, 0U, 1U};
+  Pose2 frames[5];
+  LONGS_EQUAL(PgsStatus::kOk, g.compose_chain(choices, 5U, frames));
+  check_pose(Pose2{1.0, 1.0, kPi}, frames[2]);
+  check_pose(Pose2{0.0, 1.0, -kPi / 2.0}, frames[3]);
+  check_pose(Pose2{0.0, 0.0, 0.0}, frames[4]);
+}
+
 TEST(SegmentGraph, transform_places_the_next_submap_start_on_the_previous_submap_end) {
   Fixture f(options(4U, 1U));
   SegmentGraph& g = f.graph;
