@@ -132,7 +132,9 @@ class LogReader {
 // Parses one line of a CARMEN log in isolation (exposed for tests and the fuzzer).
 // Returns kLaser/kOdom/kParam on success, kEnd for a blank line or comment or an
 // ignored message type (e.g. SYNC, TRUEPOS), and sets *reason (non-empty) iff the line
-// is malformed.
+// is malformed or its message type is unknown ("unknown message type 'X'", which the
+// reader reports as a warning). Lines over 64 KiB, bytes outside printable ASCII/tab,
+// NaN/inf, negative ranges and beam counts outside [2, kMaxBeams] are malformed.
 LogReader::Next parse_carmen_line(const std::string& line, const LogReaderOptions& options,
                                   LaserRecord* laser, OdomRecord* odom, ParamRecord* param,
                                   std::string* reason);
