@@ -221,7 +221,7 @@ class PropertyRun {
 TEST_GROUP(DpMapProperty){};
 
 TEST(DpMapProperty, every_particle_view_equals_its_naive_map_copy_and_path) {
-  PropertyRun run(Scenario{12U, 300U, 6U, 32U, 60000U, 11U});
+  PropertyRun run(Scenario{12U, 180U, 6U, 32U, 60000U, 11U});
   run.run();
   LONGS_EQUAL(0, run.refused());
   LONGS_EQUAL(0, run.fixture().map.observation_oom_count());
@@ -230,7 +230,7 @@ TEST(DpMapProperty, every_particle_view_equals_its_naive_map_copy_and_path) {
 }
 
 TEST(DpMapProperty, two_particles_long_run) {
-  PropertyRun run(Scenario{2U, 1500U, 3U, 32U, 60000U, 12U});
+  PropertyRun run(Scenario{2U, 800U, 3U, 32U, 60000U, 12U});
   run.run();
   LONGS_EQUAL(0, run.refused());
 }
@@ -238,7 +238,7 @@ TEST(DpMapProperty, two_particles_long_run) {
 // Degraded path under random operations: with too few observations and tiles, updates
 // are refused (the naive model skips exactly those), and every view still matches.
 TEST(DpMapProperty, views_stay_exact_when_pools_run_out) {
-  PropertyRun run(Scenario{10U, 200U, 8U, 2U, 150U, 13U});
+  PropertyRun run(Scenario{10U, 150U, 8U, 2U, 150U, 13U});
   run.run();
   CHECK(run.refused() > 0U);
   CHECK(run.fixture().map.observation_oom_count() > 0U);
