@@ -28,7 +28,7 @@ as_root() {
 # Packages for the host build and tests; cross and fuzz extras for `test`.
 host_pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libcpputest-dev libpng-dev zlib1g-dev
            libcli11-dev libinih-dev)
-test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user)
+test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils)
 arm64_pkgs=(libcpputest-dev:arm64)
 
 missing() {
