@@ -1,0 +1,114 @@
+// INI configuration of the filter and the offline runner's outputs.
+#include <CppUTest/TestHarness.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/run_offline.h"
+#include "shared_data.h"
+
+using namespace sdpslam;
+
+namespace {
+std::string write_temp(const std::string& text) {
+  const std::string dir = sdpslam::test::make_temp_dir("slam_config");
+  const std::string path = dir + "/c.ini";
+  std::ofstream(path) << text;
+  return path;
+}
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+TEST_GROUP(SlamConfig){};
+
+TEST(SlamConfig, shipped_default_config_loads_and_equals_the_built_in_defaults) {
+  slam::SlamConfig c;
+  c.filter.particle_count = 7;  // the file must set it back
+  std::string error;
+  CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
+  const DpSlamOptions d;
+  LONGS_EQUAL(d.particle_count, c.filter.particle_count);
+  DOUBLES_EQUAL(d.beam.sigma_hit_m, c.filter.beam.sigma_hit_m, 0.0);
+  DOUBLES_EQUAL(d.motion.alpha_rot_from_rot, c.filter.motion.alpha_rot_from_rot, 0.0);
+  DOUBLES_EQUAL(d.map_width_m, c.filter.map_width_m, 0.0);
+  LONGS_EQUAL(d.path_entries_per_particle, c.filter.path_entries_per_particle);
+  LONGS_EQUAL(d.beam.weight_beam_stride, c.filter.beam.weight_beam_stride);
+  CHECK(c.filter.validate(nullptr, 0));
+}
+
+TEST(SlamConfig, unknown_key_is_rejected_with_file_and_line) {
+  const std::string path = write_temp("[filter]\nparticles = 10\n\n[motion]\nalpha_typo = 0.1\n");
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(path, &c, &error));
+  STRCMP_CONTAINS((path + ":5:").c_str(), error.c_str());
+  STRCMP_CONTAINS("alpha_typo", error.c_str());
+}
+
+TEST(SlamConfig, out_of_range_value_is_rejected_naming_field_and_range) {
+  const std::string path = write_temp("[filter]\nparticles = 100000\n");
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(path, &c, &error));
+  STRCMP_CONTAINS(":2:", error.c_str());
+  STRCMP_CONTAINS("filter.particles", error.c_str());
+  STRCMP_CONTAINS("out of range", error.c_str());
+}
+
+TEST(SlamConfig, non_numeric_and_negative_integers_are_rejected) {
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(write_temp("[observation]\nsigma_hit_m = 0.05m\n"), &c, &error));
+  STRCMP_CONTAINS("not a finite number", error.c_str());
+  CHECK_FALSE(slam::load_config_ini(write_temp("[capacity]\npath_entries_per_particle = -3\n"), &c, &error));
+  STRCMP_CONTAINS(":2:", error.c_str());
+}
+
+TEST(SlamConfig, missing_file_is_an_error_naming_it) {
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini("/nonexistent/x.ini", &c, &error));
+  STRCMP_CONTAINS("/nonexistent/x.ini", error.c_str());
+}
+
+TEST_GROUP(RunOffline){};
+
+TEST(RunOffline, same_seed_gives_identical_trajectory_and_map_on_a_real_log) {
+  const std::string log = sdpslam::test::shared_path("datasets/dpslam-loop5.log");
+  slam::RunOptions ro;
+  ro.config.filter.particle_count = 5;
+  ro.seed = 3;
+  const std::string a = sdpslam::test::make_temp_dir("run_a");
+  const std::string b = sdpslam::test::make_temp_dir("run_b");
+  std::string error;
+  slam::RunSummary s;
+  CHECK_TRUE_TEXT(slam::run_offline(log, ro, a, &s, &error) == slam::RunStatus::kOk, error.c_str());
+  CHECK_TRUE_TEXT(slam::run_offline(log, ro, b, nullptr, &error) == slam::RunStatus::kOk, error.c_str());
+  CHECK(s.scans > 500U);
+  CHECK(s.processed > 20U);
+  const std::string ta = slurp(a + "/trajectory.txt");
+  std::size_t lines = 0;  // pose lines (comment lines start with '#')
+  std::istringstream in(ta);
+  for (std::string line; std::getline(in, line);) lines += (!line.empty() && line[0] != '#') ? 1U : 0U;
+  LONGS_EQUAL(s.scans, lines);
+  CHECK(ta == slurp(b + "/trajectory.txt"));
+  CHECK(slurp(a + "/map.pgm") == slurp(b + "/map.pgm"));
+  CHECK(!slurp(a + "/map.pgm").empty());
+  STRCMP_CONTAINS("\"naive_copy_bytes\"", slurp(a + "/stats.json").c_str());
+}
+
+TEST(RunOffline, unreadable_log_is_bad_input) {
+  slam::RunOptions ro;
+  std::string error;
+  CHECK(slam::run_offline("/nonexistent.clf", ro, sdpslam::test::make_temp_dir("run_c"), nullptr, &error) ==
+        slam::RunStatus::kBadInput);
+  CHECK(!error.empty());
+}

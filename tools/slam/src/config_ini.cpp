@@ -1,0 +1,170 @@
+#include "sdpslam/slam/config_ini.h"
+
+#include <ini.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+namespace sdpslam::slam {
+namespace {
+
+struct ParseState {
+  SlamConfig* config;
+  std::string file;
+  std::string error;
+  std::FILE* stream = nullptr;
+  int line = 0;  // lines handed to inih so far = the line being handled
+};
+
+// The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
+char* read_line(char* str, int num, void* user) {
+  auto* st = static_cast<ParseState*>(user);
+  char* r = std::fgets(str, num, st->stream);
+  if (r != nullptr) ++st->line;
+  return r;
+}
+
+bool parse_real(const char* text, double* out) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+bool parse_u32(const char* text, std::uint32_t* out) {
+  if (*text == '-' || *text == '+') return false;
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(text, &end, 10);
+  if (end == text || *end != '\0' || errno == ERANGE || v > 0xFFFFFFFFULL) return false;
+  *out = static_cast<std::uint32_t>(v);
+  return true;
+}
+
+// Nested options are addressed through small setters (member pointers cannot reach into
+// DpSlamOptions::motion / ::beam directly).
+bool set_option(DpSlamOptions& o, const std::string& section, const std::string& name, const char* value,
+                std::string* why) {
+  double r = 0.0;
+  std::uint32_t u = 0U;
+  auto real = [&](double& field) {
+    if (!parse_real(value, &r)) {
+      *why = "'" + std::string(value) + "' is not a finite number";
+      return false;
+    }
+    field = r;
+    return true;
+  };
+  auto u32 = [&](std::uint32_t& field) {
+    if (!parse_u32(value, &u)) {
+      *why = "'" + std::string(value) + "' is not a non-negative 32-bit integer";
+      return false;
+    }
+    field = u;
+    return true;
+  };
+  if (section == "filter") {
+    if (name == "particles") return u32(o.particle_count);
+    if (name == "resample_neff_ratio") return real(o.resample_neff_ratio);
+    if (name == "update_min_travel_m") return real(o.update_min_travel_m);
+    if (name == "update_min_rotation_rad") return real(o.update_min_rotation_rad);
+  } else if (section == "motion") {
+    if (name == "alpha_rot_from_rot") return real(o.motion.alpha_rot_from_rot);
+    if (name == "alpha_rot_from_trans") return real(o.motion.alpha_rot_from_trans);
+    if (name == "alpha_trans_from_trans") return real(o.motion.alpha_trans_from_trans);
+    if (name == "alpha_trans_from_rot") return real(o.motion.alpha_trans_from_rot);
+    if (name == "min_sigma_trans_m") return real(o.motion.min_sigma_trans_m);
+    if (name == "min_sigma_rot_rad") return real(o.motion.min_sigma_rot_rad);
+  } else if (section == "observation") {
+    if (name == "sigma_hit_m") return real(o.beam.sigma_hit_m);
+    if (name == "window_m") return real(o.beam.window_m);
+    if (name == "prior_hits") return real(o.beam.prior_hits);
+    if (name == "prior_misses") return real(o.beam.prior_misses);
+    if (name == "unknown_stop_probability") return real(o.beam.unknown_stop_probability);
+    if (name == "floor_likelihood") return real(o.beam.floor_likelihood);
+    if (name == "weight_beam_stride") return u32(o.beam.weight_beam_stride);
+    if (name == "max_update_range_m") return real(o.beam.max_update_range_m);
+    if (name == "no_return_free_m") return real(o.beam.no_return_free_m);
+    if (name == "likelihood_temperature") return real(o.beam.likelihood_temperature);
+  } else if (section == "map") {
+    if (name == "resolution_m") return real(o.map_resolution_m);
+    if (name == "width_m") return real(o.map_width_m);
+    if (name == "height_m") return real(o.map_height_m);
+    if (name == "tile_capacity") return u32(o.map_tile_capacity);
+    if (name == "observations_base") return u32(o.map_observations_base);
+    if (name == "observations_per_particle") return u32(o.map_observations_per_particle);
+  } else if (section == "capacity") {
+    if (name == "ancestry_nodes_per_particle") return u32(o.ancestry_nodes_per_particle);
+    if (name == "path_entries_per_particle") return u32(o.path_entries_per_particle);
+  }
+  *why = "unknown key '" + name + "' in section [" + section + "]";
+  return false;
+}
+
+int handler(void* user, const char* section, const char* name, const char* value) {
+  auto* st = static_cast<ParseState*>(user);
+  const int lineno = st->line;
+  const std::string sec(section);
+  const std::string key(name != nullptr ? name : "");
+  if (name == nullptr) return 1;  // section header alone
+  std::string why;
+  bool ok;
+  if (sec == "log") {
+    if (key == "default_range_max_m") {
+      double r = 0.0;
+      ok = parse_real(value, &r) && r > 0.0 && r <= 1000.0;
+      if (ok) st->config->log.default_range_max_m = static_cast<float>(r);
+      else why = "log.default_range_max_m: '" + std::string(value) + "' out of range (0, 1000]";
+    } else {
+      ok = false;
+      why = "unknown key '" + key + "' in section [log]";
+    }
+  } else {
+    DpSlamOptions trial = st->config->filter;
+    ok = set_option(trial, sec, key, value, &why);
+    if (ok) {
+      char reason[200];
+      if (!trial.validate(reason, sizeof reason)) {
+        ok = false;
+        why = reason;
+      } else {
+        st->config->filter = trial;
+      }
+    }
+  }
+  if (!ok) {
+    if (st->error.empty()) st->error = st->file + ":" + std::to_string(lineno) + ": " + why;
+    return 0;
+  }
+  return 1;
+}
+
+}  // namespace
+
+bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
+  std::FILE* f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) {
+    if (error != nullptr) *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  ParseState st{config, path, {}, f, 0};
+  const int rc = ini_parse_stream(read_line, &st, handler, &st);
+  std::fclose(f);
+  if (!st.error.empty()) {
+    if (error != nullptr) *error = st.error;
+    return false;
+  }
+  if (rc != 0) {
+    if (error != nullptr) *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sdpslam::slam

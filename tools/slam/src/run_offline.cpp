@@ -1,0 +1,231 @@
+#include "sdpslam/slam/run_offline.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/map_image.h"
+#include "sdpslam/io/trajectory_io.h"
+
+namespace sdpslam::slam {
+namespace {
+
+struct ScanLog {
+  std::int64_t stamp_us;
+  Pose2 odom;
+  Pose2 online;
+  bool processed;
+};
+
+class CollectSink final : public PoseSink {
+ public:
+  void on_committed(std::int64_t stamp_us, const Pose2& pose) override { poses.push_back({stamp_us, pose}); }
+  std::vector<io::StampedPose> poses;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1U) + 0.5);
+  return v[std::min(idx, v.size() - 1U)];
+}
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+}  // namespace
+
+RunStatus run_offline(const std::string& log_path, const RunOptions& options, const std::string& out_dir,
+                      RunSummary* summary, std::string* error) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const DpSlamOptions& fo = options.config.filter;
+  char why[200];
+  if (!fo.validate(why, sizeof why)) {
+    *error = std::string("invalid options: ") + why;
+    return RunStatus::kBadInput;
+  }
+  io::LogReader reader;
+  if (!reader.open(log_path, options.config.log, error)) return RunStatus::kBadInput;
+  if (!io::make_directories(out_dir, error)) return RunStatus::kIoError;
+
+  const std::size_t arena_bytes = DpSlamFilter::required_arena_bytes(fo);
+  std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
+  Arena arena(buffer.get(), arena_bytes);
+  auto filter = std::make_unique<DpSlamFilter>();
+  if (!filter->init(fo, arena, options.seed)) {
+    *error = std::string("filter init failed: ") + filter->why();
+    return RunStatus::kInternal;
+  }
+  CollectSink sink;
+  filter->set_pose_sink(&sink);
+
+  std::vector<ScanLog> scans;
+  std::vector<double> scan_ms;
+  std::vector<double> processed_ms;
+  Pose2 last_odom;
+  bool have_odom = false;
+  std::uint64_t scans_without_odom = 0U;
+  for (;;) {
+    const io::LogReader::Next k = reader.next();
+    if (k == io::LogReader::Next::kEnd) break;
+    if (k == io::LogReader::Next::kOdom) {
+      last_odom = reader.odom().pose;
+      have_odom = true;
+      continue;
+    }
+    if (k != io::LogReader::Next::kLaser) continue;
+    const io::LaserRecord& rec = reader.laser();
+    OdometrySample od;
+    od.stamp_us = rec.stamp_us;
+    if (rec.has_odom_pose) {
+      od.pose = rec.odom_pose;
+    } else if (have_odom) {
+      od.pose = last_odom;
+    } else {
+      ++scans_without_odom;  // no odometry yet: such a scan cannot be placed
+      continue;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const StepResult r = filter->process(od, rec.scan);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const bool processed = r.status == StepResult::Status::kProcessed;
+    scan_ms.push_back(ms);
+    if (processed) processed_ms.push_back(ms);
+    scans.push_back(ScanLog{rec.stamp_us, od.pose, r.pose, processed});
+    if (options.progress && scans.size() % 200U == 0U) {
+      std::fprintf(stderr, "\rscans %zu processed %llu", scans.size(),
+                   static_cast<unsigned long long>(filter->stats().processed));
+    }
+  }
+  if (options.progress) std::fprintf(stderr, "\n");
+  if (scans.empty()) {
+    *error = log_path + ": no laser scan with odometry in the log";
+    return RunStatus::kBadInput;
+  }
+
+  // The final best particle's path: committed poses, then its own uncommitted ones.
+  std::vector<io::StampedPose> path = sink.poses;
+  filter->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
+  // One pose per scan: the path where it has the scan, else the last anchored pose
+  // composed with the odometry since (skipped scans, or gaps left by path exhaustion).
+  std::vector<io::StampedPose> trajectory;
+  trajectory.reserve(scans.size());
+  std::size_t pi = 0U;
+  bool anchored = false;
+  Pose2 anchor_pose;
+  Pose2 anchor_odom;
+  std::uint64_t path_gaps = 0U;
+  for (const ScanLog& s : scans) {
+    Pose2 pose;
+    bool from_path = false;
+    if (s.processed) {
+      while (pi < path.size() && path[pi].stamp_us < s.stamp_us) ++pi;
+      if (pi < path.size() && path[pi].stamp_us == s.stamp_us) {
+        pose = path[pi].pose;
+        ++pi;
+        from_path = true;
+      } else {
+        ++path_gaps;
+      }
+    }
+    if (!from_path) pose = anchored ? anchor_pose.compose(between(anchor_odom, s.odom)) : s.online;
+    if (from_path || !anchored) {
+      anchor_pose = pose;
+      anchor_odom = s.odom;
+      anchored = true;
+    }
+    trajectory.push_back({s.stamp_us, pose});
+  }
+
+  // The best particle's map.
+  const DpMap& map = filter->map();
+  io::OccupancyImage image;
+  image.resolution_m = map.resolution_m();
+  CellRect rect;
+  std::uint32_t known_cells = 0U;
+  if (map.touched_bounds(&rect)) {
+    std::vector<CellObservation> values(static_cast<std::size_t>(rect.width) * rect.height);
+    std::vector<std::uint8_t> known(values.size(), 0U);
+    known_cells = map.fill_rect(filter->best_node(), rect, values.data(), known.data());
+    image.width = rect.width;
+    image.height = rect.height;
+    image.origin_x_m = map.options().origin_x_m + rect.ix0 * map.resolution_m();
+    image.origin_y_m = map.options().origin_y_m + rect.iy0 * map.resolution_m();
+    image.occupancy.resize(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      image.occupancy[i] = known[i] != 0U ? static_cast<float>(filter->occupancy(values[i])) : -1.0F;
+    }
+  }
+
+  if (!io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error)) return RunStatus::kIoError;
+  if (image.width > 0U) {
+    if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return RunStatus::kIoError;
+    if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return RunStatus::kIoError;
+  }
+
+  // stats.json: deterministic fields first, timing apart.
+  const AncestryTree& tree = filter->tree();
+  const DpSlamStats& st = filter->stats();
+  constexpr std::size_t kObservationBytes = 20U;  // DpMap::Observation (static_assert there)
+  constexpr std::size_t kTileBytes = (capacity::kDpTileCells + 2U) * sizeof(std::uint32_t);
+  constexpr std::size_t kPathEntryBytes = 40U;    // stamp + Pose2 + link, padded
+  const std::size_t node_bytes = tree.capacity() > 0U ? (tree.footprint_bytes() - tree.path_entry_capacity() * kPathEntryBytes) / tree.capacity() : 0U;
+  const std::size_t state_bytes = static_cast<std::size_t>(tree.peak_used()) * node_bytes +
+                                  static_cast<std::size_t>(tree.path_entries_peak()) * kPathEntryBytes +
+                                  static_cast<std::size_t>(map.observations_peak()) * kObservationBytes +
+                                  static_cast<std::size_t>(map.tiles_peak()) * kTileBytes;
+  const std::size_t naive_bytes = static_cast<std::size_t>(fo.particle_count) * known_cells * sizeof(CellObservation);
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  auto u = [](std::uint64_t v) { return std::to_string(v); };
+  std::string js = "{\n";
+  js += "  \"log\": \"" + log_path + "\",\n";
+  js += "  \"mode\": \"dpslam\",\n  \"particles\": " + u(fo.particle_count) + ",\n  \"seed\": " + u(options.seed) + ",\n";
+  js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(st.processed) + ",\n";
+  js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
+  js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
+  js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
+  js += "  \"pools\": {\n";
+  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
+        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(st.node_fallback_count) + "},\n";
+  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
+        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
+  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
+        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
+  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
+        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  js += "    \"map_updates_dropped\": " + u(st.map_updates_dropped) + ",\n";
+  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
+  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
+  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"state_bytes_peak\": " + u(state_bytes) +
+        ", \"best_map_known_cells\": " + u(known_cells) + ", \"naive_copy_bytes\": " + u(naive_bytes) + "},\n";
+  js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
+        fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
+        ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"processed_ms_p50\": " +
+        fmt("%.3f", percentile(processed_ms, 0.5)) + ", \"processed_ms_p99\": " +
+        fmt("%.3f", percentile(processed_ms, 0.99)) + ", \"processed_ms_max\": " +
+        fmt("%.3f", percentile(processed_ms, 1.0)) + ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) +
+        "}\n}\n";
+  if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return RunStatus::kIoError;
+
+  if (summary != nullptr) {
+    summary->scans = scans.size();
+    summary->processed = st.processed;
+    summary->log_error_count = reader.error_count();
+    summary->wall_time_s = wall_s;
+  }
+  return RunStatus::kOk;
+}
+
+}  // namespace sdpslam::slam
