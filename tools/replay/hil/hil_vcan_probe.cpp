@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   drivers::SocketCanBus a(opt, clock);
   drivers::SocketCanBus b(opt, clock);
   check(a.state() == hal::CanBusState::kActive && b.state() == hal::CanBusState::kActive, "both sockets open on the vcan");
-  check(a.kernel_filter_active() && a.kernel_timestamps_active(), "kernel filter and timestamps active");
+  check(a.kernel_timestamps_active(), "kernel receive timestamps (SO_TIMESTAMP) active");
 
   const std::uint8_t bytes[8] = {1, 2, 3, 4, 5, 6, 7, 8};
   const hal::CanFrame f = hal::CanFrame::standard(0x123, bytes, 8);
