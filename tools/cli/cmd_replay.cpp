@@ -165,8 +165,9 @@ int run_play(const PlayArgs& a, const char* cmd) {
     std::snprintf(opt.interface_name, sizeof opt.interface_name, "%s", a.can_iface.c_str());
     bus = std::make_unique<drivers::SocketCanBus>(opt, clock);
     if (bus->state() == hal::CanBusState::kDown) {
-      std::fprintf(stderr, "sdpslam %s: %s: %s (errno %d); frames wait for it\n", cmd, a.can_iface.c_str(),
+      std::fprintf(stderr, "sdpslam %s: cannot open CAN interface %s: %s (errno %d)\n", cmd, a.can_iface.c_str(),
                    drivers::to_string(bus->last_error()), bus->last_errno());
+      return kExitIo;
     }
   }
   replay::ReplayLog log;
