@@ -125,7 +125,7 @@ timeout -k 5 "$timeout_s" qemu-system-x86_64 -accel tcg -m 512M -nographic -no-r
 qemu_rc=$?
 set -e
 end=$(date +%s.%N)
-tr -d '\r' <"$console" | sed -n '/@@HIL-START@@/,/@@HIL-EXIT/p' | grep -v '@@HIL-'
+tr -d '\r' <"$console" | sed -n '/@@HIL-START@@/,/@@HIL-EXIT/p' | grep -v '@@HIL-' || true  # the command may print nothing
 elapsed=$(awk -v a="$start" -v b="$end" 'BEGIN {printf "%.1f", b - a}')
 rc=$(tr -d '\r' <"$console" | sed -n 's/.*@@HIL-EXIT \([0-9]*\)@@.*/\1/p' | tail -n 1)
 if [ -z "$rc" ]; then
