@@ -96,20 +96,24 @@ TEST(ReplayPlayer, frames_arrive_at_their_recorded_times_over_a_socketpair_at_sp
   LONGS_EQUAL(frames.size(), player.stats().frames_sent);
   LONGS_EQUAL(0, player.stats().frames_dropped);
   double worst_us = 0.0, sum_us = 0.0;
+  std::size_t early = 0;
   for (std::size_t i = 0; i < got.size(); ++i) {
     LONGS_EQUAL(frames[i].frame.id, got[i].id);  // order kept
     const std::int64_t due = player.timeline().due_us(frames[i].stamp_us);
+    if (rx_us[i] < due) ++early;  // never before its time
     const double err = std::fabs(static_cast<double>(rx_us[i] - due));
     worst_us = std::fmax(worst_us, err);
     sum_us += err;
   }
   const double mean_us = sum_us / static_cast<double>(got.size());
-  // 2 s of log in 100 ms: on average within a millisecond of the scaled time; the worst
-  // case is bounded by what a shared, loaded machine's scheduler allows.
+  // 2 s of log in 100 ms: no frame before its scaled time, on average within a few
+  // milliseconds after it (arrival includes the receiving thread's wake-up); the worst case
+  // is bounded by what a shared, loaded machine's scheduler allows.
   std::printf("\nplayer x20: %zu frames, |arrival - due| mean %.0f us, worst %.0f us, wall %.1f ms\n", got.size(),
               mean_us, worst_us, static_cast<double>(player.stats().wall_us) / 1000.0);
-  CHECK_TRUE(mean_us < 1000.0);
-  CHECK_TRUE(worst_us < 20000.0);
+  LONGS_EQUAL(0, early);
+  CHECK_TRUE(mean_us < 3000.0);
+  CHECK_TRUE(worst_us < 30000.0);
   CHECK_TRUE(player.stats().wall_us < 400000);
 }
 
