@@ -123,7 +123,8 @@ bool SocketCanBus::open_interface() {
     return false;
   }
   ifreq ifr{};
-  std::strncpy(ifr.ifr_name, options_.interface_name, IFNAMSIZ - 1);
+  // ifr is zeroed, so the name stays terminated (memcpy: GCC -O2 rejects this strncpy).
+  std::memcpy(ifr.ifr_name, options_.interface_name, ::strnlen(options_.interface_name, IFNAMSIZ - 1));
   if (::ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
     last_error_ = SocketCanError::kNoInterface;
     last_errno_ = errno;
