@@ -57,7 +57,11 @@ install() {
 
 configure_build() {  # preset
   log "build: $1"
-  cmake --preset "$1" >"build/$1.configure.log" 2>&1 || { cat "build/$1.configure.log"; die "configure $1 failed"; }
+  if ! cmake --preset "$1" >"build/$1.configure.log" 2>&1; then
+    cat "build/$1.configure.log"
+    echo "quickstart: configure of $1 failed" >&2
+    return 1
+  fi
   cmake --build --preset "$1" -j "$jobs"
 }
 
