@@ -229,4 +229,58 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   return result;
 }
 
+bool DpSlamFilter::is_particle_node(NodeId node) const {
+  for (std::uint32_t i = 0; i < particle_count_; ++i) {
+    if (particles_[i].node == node) return true;
+  }
+  return false;
+}
+
+bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
+  if (!initialised_ || !started_) {
+    ++restart_refused_count_;
+    return false;
+  }
+  // All or nothing: the root and one child per particle must fit.
+  if (tree_.capacity() - tree_.size() < particle_count_ + 1U) {
+    ++restart_refused_count_;
+    return false;
+  }
+  const NodeId root = tree_.create_root();
+  if (root == kNoNode) {
+    ++restart_refused_count_;
+    return false;
+  }
+  stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose);
+  for (std::uint32_t i = 0; i < particle_count_; ++i) {
+    NodeId c = tree_.add_child(root);
+    if (c == kNoNode) {  // cannot happen after the capacity check; degraded path anyway
+      c = root;
+      ++stats_.node_fallback_count;
+    }
+    // The old node stays active: it is the anchored leaf of the finished segment.
+    particles_[i] = Particle{c, start_pose, 0.0};
+  }
+  if (particles_[0].node != root) tree_.set_active(root, false);
+  tree_.prune(&map_);
+  best_index_ = 0U;
+  last_best_pose_ = start_pose;
+  return true;
+}
+
+bool DpSlamFilter::release_anchored(NodeId node) {
+  if (!tree_.contains(node) || is_particle_node(node)) return false;
+  if (!tree_.set_active(node, false)) return false;
+  tree_.prune(&map_);
+  return true;
+}
+
+NodeId DpSlamFilter::create_anchored_root() { return initialised_ ? tree_.create_root() : kNoNode; }
+
+bool DpSlamFilter::add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits,
+                                   std::uint16_t misses) {
+  if (is_particle_node(node)) return false;
+  return map_.add(node, ix, iy, hits, misses);
+}
+
 }  // namespace sdpslam

@@ -87,8 +87,12 @@ bool DpSlamOptions::validate(char* why, std::size_t n) const {
     const std::uint64_t obs = static_cast<std::uint64_t>(map_observations_base) +
                               static_cast<std::uint64_t>(particle_count) * map_observations_per_particle;
     c.integer("map.observations_base + particles*observations_per_particle", obs, 1U, 0xF0000000U);
-    c.integer("particles*capacity.path_entries_per_particle",
-              static_cast<std::uint64_t>(particle_count) * path_entries_per_particle, 1U, 0xF0000000U);
+    c.integer("particles*capacity.path_entries_per_particle + extra_path_entries",
+              static_cast<std::uint64_t>(particle_count) * path_entries_per_particle + extra_path_entries, 1U,
+              0xF0000000U);
+    c.integer("particles*capacity.ancestry_nodes_per_particle + extra_ancestry_nodes",
+              static_cast<std::uint64_t>(particle_count) * ancestry_nodes_per_particle + extra_ancestry_nodes, 1U,
+              0x10000000U);
     c.integer("map tiles (0 = whole area)", map_tile_capacity == 0U ? tiles_of_area(*this) : map_tile_capacity, 1U,
               capacity::kDpMaxTiles);
   }

@@ -102,3 +102,26 @@ inline constexpr std::uint32_t kDpSlamMaxPathEntriesPerParticle = 1000000U;
 static_assert(kDpSlamMaxNodesPerParticle >= kAncestryNodesPerParticle, "nodes per particle bound below the tree's need");
 
 }  // namespace sdpslam::capacity
+
+// ---- SDP-SLAM two-level filter (sdp_slam.h) -----------------------------------------
+namespace sdpslam::capacity {
+
+#ifndef SDPSLAM_MAX_TOP_PARTICLES
+#define SDPSLAM_MAX_TOP_PARTICLES 256
+#endif
+#ifndef SDPSLAM_MAX_PERMANENT_SUBMAPS
+#define SDPSLAM_MAX_PERMANENT_SUBMAPS 4096
+#endif
+
+// Top-level particles (samples of submap combinations, paper §III, "60T").
+inline constexpr std::uint32_t kMaxTopParticles = SDPSLAM_MAX_TOP_PARTICLES;
+static_assert(kMaxTopParticles >= 1U && kMaxTopParticles <= 4096U, "kMaxTopParticles out of range");
+// Permanent submaps whose skeletons stay available for loop-closing matches; beyond this
+// the oldest are forgotten (counted), their map is already in the global map.
+inline constexpr std::uint32_t kMaxPermanentSubmaps = SDPSLAM_MAX_PERMANENT_SUBMAPS;
+static_assert(kMaxPermanentSubmaps >= 1U && kMaxPermanentSubmaps <= 65536U, "kMaxPermanentSubmaps out of range");
+// Bottom particles per segment in SDP-SLAM: a PGS level holds one node per particle and a
+// top-level choice is stored in 16 bits.
+static_assert(kMaxPgsNodesPerLevel <= 65535U, "PGS node index must fit 16 bits");
+
+}  // namespace sdpslam::capacity

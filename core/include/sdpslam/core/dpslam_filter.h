@@ -101,6 +101,30 @@ class DpSlamFilter {
   // Occupancy probability the filter believes for a cell observation (for map output).
   double occupancy(const CellObservation& c) const { return beam_.stop_probability(c); }
 
+  // ---- segments (SDP-SLAM, paper §III, Algorithm 1 lines 5-6) ---------------------
+  // Anchorage and restart: the current particles' nodes stay in the tree, ACTIVE, so
+  // their map views and paths (the finished segment's submaps) remain readable and can
+  // no longer change (no particle descends from them any more); every particle then
+  // restarts at `start_pose` on one fresh root (a new tree of the forest) with an empty
+  // map, except that the last processed scan is written into that root at start_pose,
+  // so the new submap begins with what the robot sees where it starts. Weights become
+  // uniform. Poses are not recorded on the new root (start_pose is the finished
+  // segment's last pose). Returns false, changing nothing, iff the filter has not
+  // processed a scan yet or the node pool cannot hold the root and the particles'
+  // children (restart_refused_count() bumps). O(N + beams).
+  bool restart_segment(const Pose2& start_pose);
+  // Makes an anchored node inactive and prunes, so its observations and poses are freed
+  // once nothing descends from it. False (nothing changes) iff `node` is dead or is the
+  // node of a current particle. O(prune).
+  bool release_anchored(NodeId node);
+  // A new root node that is not a particle (e.g. a permanent global map assembled from
+  // finished submaps); it stays active until released. kNoNode iff the pool is full.
+  NodeId create_anchored_root();
+  // Adds evidence to cell (ix, iy) of a node that is not a current particle (same
+  // failure rules as DpMap::add, plus false iff `node` is a current particle).
+  bool add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
+  std::uint32_t restart_refused_count() const { return restart_refused_count_; }
+
   const DpMap& map() const { return map_; }
   const AncestryTree& tree() const { return tree_; }
   const DpSlamOptions& options() const { return options_; }
@@ -118,6 +142,7 @@ class DpSlamFilter {
   };
 
   void first_scan(const OdometrySample& odom, const RangeScan& scan, StepResult* result);
+  bool is_particle_node(NodeId node) const;
 
   DpSlamOptions options_{};
   AncestryTree tree_;
@@ -143,6 +168,7 @@ class DpSlamFilter {
   bool started_ = false;
   OdometrySample last_odom_{};         // odometry at the last processed scan
   Pose2 last_best_pose_{};             // best pose at the last processed scan
+  std::uint32_t restart_refused_count_ = 0U;
   char why_[160] = {};
 };
 

@@ -31,14 +31,19 @@ struct DpSlamOptions {
   // [capacity]
   std::uint32_t ancestry_nodes_per_particle = capacity::kAncestryNodesPerParticle;
   std::uint32_t path_entries_per_particle = 64U;         // uncommitted poses per particle
+  // Extra pool room for callers that keep finished segments alive: SDP-SLAM anchors the
+  // leaves of every live segment (Algorithm 1 line 5), whose nodes and poses stay in the
+  // tree until the segment is made permanent. 0 for plain DP-SLAM.
+  std::uint32_t extra_ancestry_nodes = 0U;
+  std::uint32_t extra_path_entries = 0U;
 
   // True iff every field is in range; otherwise writes "field: value out of range
   // [lo, hi]" (truncated to n bytes, NUL-terminated) into `why` (may be null).
   bool validate(char* why, std::size_t n) const;
 
   // Derived capacities (valid options only).
-  std::uint32_t node_capacity() const { return particle_count * ancestry_nodes_per_particle; }
-  std::uint32_t path_entry_capacity() const { return particle_count * path_entries_per_particle; }
+  std::uint32_t node_capacity() const { return particle_count * ancestry_nodes_per_particle + extra_ancestry_nodes; }
+  std::uint32_t path_entry_capacity() const { return particle_count * path_entries_per_particle + extra_path_entries; }
   std::uint32_t observation_capacity() const;
   std::uint32_t tile_capacity() const;
 };

@@ -1,0 +1,82 @@
+#pragma once
+// Options of SDP-SLAM's segmentation and top level (paper §III, Algorithm 1 lines 4-12),
+// validated once: validate() range-checks every field and names the first bad one.
+// The bottom level keeps its own DpSlamOptions (dpslam_options.h); every field here has
+// a key in the [sdp] section of tools/slam/default.ini.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/capacities.h"
+#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/segment_graph.h"
+
+namespace sdpslam {
+
+// Line 4, "segmentation decision": the paper tested both.
+enum class SegmentationMode : std::uint8_t {
+  kPeriodic,    // every period_* (whichever is reached first among those > 0)
+  kDispersion,  // when the bottom particles' positions spread beyond dispersion_threshold_m
+};
+
+// How the top level searches combinations (§IV compares the two topologies).
+enum class TopologyMode : std::uint8_t {
+  kSdp,      // SDP-SLAM: diversification re-samples choices anywhere in the live chain
+  kSegSlam,  // SegSLAM's local analysis: only the last segslam_window segments are
+             // re-sampled; older choices follow the best particle's
+};
+
+struct SdpOptions {
+  // [sdp] top level
+  std::uint32_t top_particles = 60U;  // 1 .. capacity::kMaxTopParticles
+  TopologyMode topology = TopologyMode::kSdp;
+  std::uint32_t segslam_window = 3U;  // segments SegSLAM re-samples, >= 1
+  double elite_fraction = 0.2;        // kept unchanged each round, [0, 1]
+  double worst_fraction = 0.2;        // replaced by copies of the elite, [0, 1], elite+worst <= 1
+  std::uint32_t diversify_levels = 2U;  // choices re-sampled per diversified particle, >= 1
+  // Share of the particles that, at a segmentation, extend their combination with the
+  // bottom filter's best submap (the others sample it from the PGS), [0, 1].
+  double follow_best_fraction = 0.25;
+  std::uint32_t rounds_per_segment = 3U;    // evaluation rounds after a segmentation, >= 1
+  std::uint32_t evaluations_per_scan = 8U;  // particles evaluated per scan (time budget), >= 1
+  std::uint32_t max_pairs_per_sample = 6U;  // overlapping submap pairs matched per sample, >= 1
+  double overlap_margin_m = 0.0;            // bounding boxes grown by this before the test
+  double min_overlap_m2 = 4.0;              // pairs whose boxes share less area are ignored
+  // [sdp] segmentation
+  SegmentationMode segmentation = SegmentationMode::kPeriodic;
+  double period_travel_m = 8.0;       // periodic: travel per segment (0 = not used)
+  double period_time_s = 0.0;         // periodic: log time per segment (0 = not used)
+  std::uint32_t period_scans = 0U;    // periodic: processed scans per segment (0 = not used)
+  double dispersion_threshold_m = 0.15;  // dispersion: RMS distance of the particles to their mean
+  std::uint32_t min_segment_scans = 10U;   // processed scans before any segmentation, >= 1
+  std::uint32_t max_segment_scans = 120U;  // a segment never gets longer (bounds storage)
+  // [sdp] PGS
+  std::uint32_t max_levels = 12U;  // live PGS levels, 2 .. capacity::kMaxPgsLevels
+  PgsAccumulation accumulation = PgsAccumulation::kSum;
+  double prior_error_m = 1.0;      // effective error of never-sampled edges (and of
+                                   // never-evaluated particles when ranking)
+  std::uint32_t max_permanent_submaps = 512U;  // 1 .. capacity::kMaxPermanentSubmaps
+  // [sdp] skeleton (free-space points per submap, computed at anchorage)
+  std::uint32_t skeleton_points = 300U;  // per submap, 8 .. capacity::kMaxIcpPoints
+  std::uint32_t skeleton_downsample = 2U;  // skeleton grid = map cells × this, 1 .. 8
+  double skeleton_pad_m = 3.0;             // around the submap's path
+  double skeleton_max_side_m = 40.0;       // patch side bound (also the work buffers)
+  double skeleton_min_clearance_m = 0.2;
+  double occupied_threshold = 0.6;  // occupancy >= this is an obstacle
+  double free_threshold = 0.35;     // occupancy <= this is free
+  std::uint32_t work_cells_per_scan = 250000U;  // map cells read per scan by anchorage work
+  // [sdp] ICP (Icp2d options)
+  Icp2dOptions icp{};
+
+  SdpOptions() {
+    icp.max_iterations = 30U;
+    icp.max_correspondence_m = 1.0;
+    icp.nn_cell_m = 0.2;
+    icp.min_pairs = 20U;
+  }
+
+  // True iff every field is in range; otherwise writes "sdp.field: value out of range
+  // [lo, hi]" into `why` (may be null).
+  bool validate(char* why, std::size_t n) const;
+};
+
+}  // namespace sdpslam

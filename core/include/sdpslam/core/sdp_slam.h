@@ -1,0 +1,364 @@
+#pragma once
+// Segmented DP-SLAM (paper §III, Algorithm 1): the two-level filter.
+//
+// Bottom level (lines 3-6): a DpSlamFilter builds the submaps of the current segment.
+// At a segmentation (segmentation.h) the particles' nodes are ANCHORED (left active in
+// the ancestry tree, so their map views and paths can no longer change) and the
+// particles RESTART at a common pose on a fresh root with an empty map
+// (DpSlamFilter::restart_segment). The restart pose is the bottom filter's best pose in
+// the DP map's grid frame, so consecutive segments do not pile up in one spot of the
+// shared grid; each segment still has its own local frame (Fig. 3 (l)): a submap's
+// initial pose is that restart pose and its final pose the particle's pose at the next
+// segmentation, and T_ab = final_a ⊕ initial_b⁻¹ (SegmentGraph's convention).
+//
+// Top level (lines 7-12): the PGS (segment_graph.h) gets one level per segment, one node
+// per bottom particle. At anchorage every node's free-space skeleton (Fig. 2 (b)) is
+// extracted from its DP-map view around its path, in the submap frame, into fixed
+// storage. T top-level particles each hold one submap choice per live level. After a
+// segmentation they are resampled with ELITISM (the best elite_fraction are kept, the
+// worst worst_fraction replaced by copies of the elite, all but the elite diversify by
+// re-sampling choices from the PGS with conditional sampling p(b | a)), extended to the
+// new level, and evaluated: the combination's submaps are placed in one frame by
+// composing T; non-adjacent submaps whose global bounding boxes overlap (at most
+// max_pairs_per_sample pairs, largest overlap first, permanent submaps included) are
+// matched with ICP on their skeleton points from the composed chain as initial guess;
+// the sample's error is the mean nearest-neighbour distance over all matched point
+// pairs ("ICP nearest neighbour error"). A pair whose boxes overlap but whose ICP finds
+// too few correspondences counts as icp.max_correspondence_m (a gross misalignment must
+// not look like "no overlap"). The error weights the particle (lower is better) and is
+// added to the PGS edges of the combination between the oldest and newest live level
+// involved (line 12, equation (4)). Samples without any overlap keep their weight
+// ("in the rest of the process the weights are not changed", §IV). Up to
+// rounds_per_segment rounds run after each segmentation, as long as samples overlap.
+//
+// SegSLAM topology (§IV comparison, TopologyMode::kSegSlam): identical except that
+// diversification re-samples only the last segslam_window levels and older choices
+// follow the best particle's (a local analysis of chains of few segments).
+//
+// Bounded memory: when all max_levels PGS levels are live, the oldest becomes PERMANENT
+// with the best top particle's choice: that submap's poses go to the permanent pose
+// sink in the global frame, its map is copied into one global "permanent map" node
+// (a tree root that is not a particle) and its skeleton into a ring of permanent
+// submaps (still matched for loop closures); the level's other submaps are released
+// (set_active(false) + prune frees their DP-map observations; counted).
+//
+// Worst-scan time: anchorage work (skeleton extraction, map transfer) is done in chunks
+// of at most work_cells_per_scan map cells per call of process(), and top-level samples
+// are evaluated evaluations_per_scan per call, so the work of a segmentation is spread
+// over the following scans. All counts, no clocks: the output is deterministic.
+//
+// Memory: init() carves everything from the caller's Arena (required_arena_bytes());
+// process() never touches the heap. The object is large (ICP tables, bottom filter):
+// allocate it once at start-up.
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/free_space_skeleton.h"
+#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/segment_graph.h"
+#include "sdpslam/core/segmentation.h"
+
+namespace sdpslam {
+
+struct SdpStepResult {
+  StepResult bottom;      // the bottom filter's step (pose in the current segment's frame)
+  Pose2 pose;             // the estimate in the global frame (best top-level particle)
+  SegmentEnd segmented = SegmentEnd::kNone;
+  std::uint32_t evaluations = 0U;  // top-level samples evaluated during this call
+  std::uint32_t work_cells = 0U;   // map cells read by anchorage work during this call
+};
+
+struct SdpStats {
+  std::uint64_t segments = 0U;            // segmentations done (levels added)
+  std::uint64_t restart_refused = 0U;     // segmentation postponed: no room to restart
+  std::uint64_t pgs_refused = 0U;         // add_level refused (should stay 0)
+  std::uint64_t levels_made_permanent = 0U;
+  std::uint64_t submaps_released = 0U;    // submaps freed when their level became permanent
+  std::uint64_t permanent_forgotten = 0U; // permanent skeletons dropped from the ring
+  std::uint64_t skeletons = 0U;
+  std::uint64_t skeleton_truncated_points = 0U;
+  std::uint64_t map_transfer_cells = 0U;
+  std::uint64_t map_transfer_dropped = 0U;  // global-map cell updates refused (pool full)
+  std::uint64_t rounds = 0U;
+  std::uint64_t rounds_with_overlap = 0U;
+  std::uint64_t evaluations = 0U;
+  std::uint64_t evaluations_with_overlap = 0U;
+  std::uint64_t icp_matches = 0U;
+  std::uint64_t icp_failures = 0U;          // overlapping boxes, too few correspondences
+  std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
+  std::uint32_t pose_ring_peak = 0U;
+  std::uint32_t max_live_levels = 0U;
+  // All evaluated samples with overlap (Table I's μ and σ).
+  double error_sum_m = 0.0;
+  double error_sq_sum_m2 = 0.0;
+  std::uint64_t error_samples = 0U;
+  double error_mean_m() const { return error_samples > 0U ? error_sum_m / static_cast<double>(error_samples) : 0.0; }
+  double error_std_m() const;
+};
+
+// Told about every finished evaluation round in which some sample overlapped.
+class TopLevelListener {
+ public:
+  virtual void on_round(std::int64_t stamp_us, double mean_error_m, double std_error_m, std::uint32_t samples) = 0;
+
+ protected:
+  ~TopLevelListener() = default;
+};
+
+class SdpSlam {
+ public:
+  SdpSlam() = default;
+  SdpSlam(const SdpSlam&) = delete;
+  SdpSlam& operator=(const SdpSlam&) = delete;
+
+  // The bottom options SDP-SLAM actually uses: `bottom` plus the pool room anchored
+  // segments need (extra ancestry nodes and path entries for max_levels segments).
+  static DpSlamOptions bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp);
+  // Arena bytes init() needs (0 iff the options are invalid).
+  static std::size_t required_arena_bytes(const DpSlamOptions& bottom, const SdpOptions& sdp);
+  // False iff options are invalid or the arena too small (why() says which). Call once.
+  bool init(const DpSlamOptions& bottom, const SdpOptions& sdp, Arena& arena, std::uint64_t seed);
+  const char* why() const { return why_; }
+
+  // One scan: bottom update, segmentation decision, anchorage/restart, top-level work
+  // within the per-scan budget.
+  SdpStepResult process(const OdometrySample& odom, const RangeScan& scan);
+  // Completes pending anchorage work (skeletons, map transfer) at once, e.g. before the
+  // outputs are read at the end of a run. Not bounded by the per-scan budget.
+  void finish();
+
+  // Poses of segments made permanent, in the global frame, in time order. Not owned.
+  void set_permanent_sink(PoseSink* sink) { permanent_sink_ = sink; }
+  void set_listener(TopLevelListener* listener) { listener_ = listener; }
+
+  // ---- the best combination ---------------------------------------------------------
+  // f(stamp_us, pose_in_global) for every pose of the live levels' chosen submaps and of
+  // the current segment's best particle, oldest first (permanent segments went to the
+  // sink). Uses the tree's scratch walk: do not call back into this object from f.
+  template <class F>
+  void for_each_best_pose(F&& f) const;
+  // f(node, frame_in_global, rect) for every DP-map view that makes up the best global
+  // map: the permanent map node (identity frame), each live level's chosen submap and
+  // the current segment's best particle; rect bounds the cells worth reading.
+  template <class F>
+  void for_each_best_submap(F&& f) const;
+  // Frame of the current segment in the global frame for the best top particle.
+  Pose2 current_frame() const { return current_frame_; }
+  std::uint32_t best_top_particle() const { return best_top_; }
+
+  const DpSlamFilter& bottom() const { return *filter_; }
+  const SegmentGraph& graph() const { return graph_; }
+  const SdpOptions& options() const { return options_; }
+  const SdpStats& stats() const { return stats_; }
+  std::uint32_t permanent_submap_count() const { return perm_count_; }
+  std::uint32_t pose_ring_capacity() const { return ring_capacity_; }
+  std::size_t arena_bytes_used() const { return arena_used_; }
+  // Mean/std of the ICP error over the top-level particles that have one (0 if none).
+  void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;
+
+  // Pure helper: share (m²) of the overlap of two axis-aligned boxes.
+  static double box_overlap_m2(const double a[4], const double b[4]);
+
+ private:
+  struct StampedPose {
+    std::int64_t stamp_us;
+    Pose2 pose;
+  };
+  struct Submap {
+    NodeId node = kNoNode;
+    Pose2 initial;
+    Pose2 final_pose;
+    double box[4] = {0.0, 0.0, 0.0, 0.0};  // skeleton points' bounds, submap frame
+    CellRect map_rect{};                    // cells worth reading for its map
+    CellRect path_rect{};                   // its path's cells (skeleton patch seed)
+    std::uint32_t point_count = 0U;
+    bool skeleton_done = false;
+  };
+  struct Level {
+    std::int64_t start_stamp_us = 0;  // exclusive (the previous segment's last scan)
+    std::int64_t end_stamp_us = 0;    // inclusive
+    std::uint32_t count = 0U;
+  };
+  struct Permanent {
+    Pose2 frame_in_global;
+    double box[4] = {0.0, 0.0, 0.0, 0.0};
+    std::uint32_t level = 0U;
+    std::uint32_t point_count = 0U;
+  };
+  struct Transfer {
+    bool active = false;
+    NodeId node = kNoNode;
+    Pose2 frame;
+    CellRect rect{};
+    std::uint32_t next_row = 0U;
+  };
+  class RingSink final : public PoseSink {
+   public:
+    explicit RingSink(SdpSlam& owner) : owner_(owner) {}
+    void on_committed(std::int64_t stamp_us, const Pose2& pose) override { owner_.ring_push(stamp_us, pose); }
+
+   private:
+    SdpSlam& owner_;
+  };
+
+  std::uint32_t slot(std::uint32_t level) const { return level % options_.max_levels; }
+  Submap& submap(std::uint32_t level, std::uint32_t node) { return submaps_[slot(level) * n_bottom_ + node]; }
+  const Submap& submap(std::uint32_t level, std::uint32_t node) const {
+    return submaps_[slot(level) * n_bottom_ + node];
+  }
+  Point2* live_points(std::uint32_t level, std::uint32_t node) const {
+    return live_points_ + (static_cast<std::size_t>(slot(level)) * n_bottom_ + node) * options_.skeleton_points;
+  }
+  Point2* perm_points(std::uint32_t index) const {
+    return perm_points_ + static_cast<std::size_t>(index) * options_.skeleton_points;
+  }
+  std::uint16_t& choice(std::uint32_t particle, std::uint32_t level) {
+    return choices_[particle * options_.max_levels + slot(level)];
+  }
+  std::uint16_t choice(std::uint32_t particle, std::uint32_t level) const {
+    return choices_[particle * options_.max_levels + slot(level)];
+  }
+
+  void ring_push(std::int64_t stamp_us, const Pose2& pose);
+  template <class F>
+  void for_each_level_pose(std::uint32_t level, NodeId leaf, F&& f) const;
+  template <class F>
+  void for_each_current_pose(F&& f) const;
+  CellRect rect_around(double x0, double y0, double x1, double y1, double pad_m) const;
+
+  void segment(std::int64_t stamp_us);
+  void make_oldest_permanent();
+  std::uint32_t do_work(std::uint32_t budget_cells);
+  std::uint32_t extract_skeleton(std::uint32_t level, std::uint32_t node);
+  std::uint32_t transfer_rows(std::uint32_t budget_cells);
+  void rank_particles();
+  void resample_and_diversify();
+  void extend_to_level(std::uint32_t level, std::uint32_t bottom_best);
+  void evaluate(std::uint32_t particle);
+  void end_round(std::int64_t stamp_us, bool may_continue);
+  void update_best();
+  double key(std::uint32_t particle) const;
+
+  SdpOptions options_{};
+  DpSlamOptions bottom_options_{};
+  DpSlamFilter* filter_ = nullptr;  // in the arena
+  Icp2d* icp_ = nullptr;            // in the arena
+  SegmentGraph graph_;
+  FreeSpaceSkeleton skeleton_;
+  Segmenter* segmenter_ = nullptr;
+  Rng rng_;
+  RingSink ring_sink_{*this};
+  PoseSink* permanent_sink_ = nullptr;
+  TopLevelListener* listener_ = nullptr;
+  SdpStats stats_{};
+
+  std::uint32_t n_bottom_ = 0U;
+  std::uint32_t n_top_ = 0U;
+  Submap* submaps_ = nullptr;       // max_levels × N
+  Point2* live_points_ = nullptr;   // max_levels × N × skeleton_points
+  Level* levels_ = nullptr;         // max_levels
+  Permanent* perm_ = nullptr;       // ring of max_permanent_submaps
+  Point2* perm_points_ = nullptr;
+  std::uint32_t perm_head_ = 0U;
+  std::uint32_t perm_count_ = 0U;
+  std::uint16_t* choices_ = nullptr;   // T × max_levels (by level slot)
+  std::uint16_t* scratch_choices_ = nullptr;  // T × max_levels (elitism copies)
+  double* error_ = nullptr;            // T
+  std::uint8_t* has_error_ = nullptr;  // T
+  std::uint32_t* order_ = nullptr;     // T, rank → particle
+  std::uint32_t* chain_ = nullptr;     // max_levels
+  Pose2* frames_ = nullptr;            // max_levels: the best particle's chain
+  Pose2* eval_frames_ = nullptr;       // max_levels: the chain being evaluated
+  Pose2* poses_scratch_ = nullptr;     // N
+  StampedPose* ring_ = nullptr;
+  std::uint32_t ring_capacity_ = 0U;
+  std::uint32_t ring_head_ = 0U;
+  std::uint32_t ring_count_ = 0U;
+  CellObservation* fine_values_ = nullptr;
+  std::uint8_t* fine_known_ = nullptr;
+  std::size_t fine_cells_ = 0U;
+  CellState* coarse_ = nullptr;
+  std::uint32_t coarse_side_ = 0U;
+  Transfer transfer_{};
+  NodeId global_node_ = kNoNode;
+
+  // Current segment.
+  bool started_ = false;
+  Pose2 segment_start_pose_{};     // restart pose (current segment's initial pose)
+  std::int64_t segment_start_stamp_us_ = 0;  // exclusive
+  std::int64_t last_processed_stamp_us_ = 0;
+  double seg_box_[4] = {0.0, 0.0, 0.0, 0.0};  // best poses of the current segment
+  // Top-level round.
+  bool round_active_ = false;
+  std::uint32_t eval_cursor_ = 0U;
+  std::uint32_t rounds_in_segment_ = 0U;
+  double round_sum_ = 0.0;
+  double round_sq_ = 0.0;
+  std::uint32_t round_samples_ = 0U;
+  std::uint32_t best_top_ = 0U;
+  Pose2 current_frame_{};
+  std::size_t arena_used_ = 0U;
+  bool initialised_ = false;
+  char why_[200] = {};
+};
+
+// ---- templates ----------------------------------------------------------------------
+
+template <class F>
+void SdpSlam::for_each_level_pose(std::uint32_t level, NodeId leaf, F&& f) const {
+  const Level& lv = levels_[slot(level)];
+  for (std::uint32_t k = 0; k < ring_count_; ++k) {
+    const StampedPose& e = ring_[(ring_head_ + k) % ring_capacity_];
+    if (e.stamp_us > lv.start_stamp_us && e.stamp_us <= lv.end_stamp_us) f(e.stamp_us, e.pose);
+  }
+  filter_->tree().for_each_pose_from_root(leaf, f);
+}
+
+template <class F>
+void SdpSlam::for_each_current_pose(F&& f) const {
+  for (std::uint32_t k = 0; k < ring_count_; ++k) {
+    const StampedPose& e = ring_[(ring_head_ + k) % ring_capacity_];
+    if (e.stamp_us > segment_start_stamp_us_) f(e.stamp_us, e.pose);
+  }
+  filter_->for_each_best_pose(f);
+}
+
+template <class F>
+void SdpSlam::for_each_best_pose(F&& f) const {
+  if (!initialised_) return;
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t count = graph_.live_level_count();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const std::uint32_t level = first + i;
+    const Pose2 frame = frames_[i];
+    const Submap& sm = submap(level, choice(best_top_, level));
+    for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) { f(s, frame.compose(p)); });
+  }
+  const Pose2 cur = current_frame_;
+  for_each_current_pose([&](std::int64_t s, const Pose2& p) { f(s, cur.compose(p)); });
+}
+
+template <class F>
+void SdpSlam::for_each_best_submap(F&& f) const {
+  if (!initialised_ || !started_) return;
+  CellRect all{};
+  if (global_node_ != kNoNode && filter_->map().touched_bounds(&all)) f(global_node_, Pose2{}, all);
+  if (transfer_.active) {
+    CellRect rest = transfer_.rect;
+    rest.iy0 += static_cast<std::int32_t>(transfer_.next_row);
+    rest.height -= transfer_.next_row;
+    f(transfer_.node, transfer_.frame, rest);
+  }
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t count = graph_.live_level_count();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Submap& sm = submap(first + i, choice(best_top_, first + i));
+    f(sm.node, frames_[i], sm.map_rect);
+  }
+  const double pad = bottom_options_.beam.max_update_range_m;
+  f(filter_->best_node(), current_frame_, rect_around(seg_box_[0], seg_box_[1], seg_box_[2], seg_box_[3], pad));
+}
+
+}  // namespace sdpslam

@@ -1,0 +1,810 @@
+#include "sdpslam/core/sdp_slam.h"
+
+#include <cstdio>
+#include <new>
+
+#include "sdpslam/core/det_math.h"
+
+namespace sdpslam {
+namespace {
+
+constexpr std::size_t kSlack = 64U;
+
+template <typename T>
+std::size_t bytes_of(std::size_t n) {
+  return sizeof(T) * n + alignof(T) + kSlack;
+}
+
+std::uint32_t fine_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
+  return static_cast<std::uint32_t>(s.skeleton_max_side_m / b.map_resolution_m) + 2U;
+}
+std::uint32_t coarse_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
+  return fine_side_cells(b, s) / s.skeleton_downsample + 2U;
+}
+std::uint32_t ring_capacity_for(const SdpOptions& s) { return (s.max_levels + 2U) * (s.max_segment_scans + 2U); }
+
+SegmentGraphOptions graph_options(const SdpOptions& s, std::uint32_t n) {
+  SegmentGraphOptions g;
+  g.max_levels = s.max_levels;
+  g.nodes_per_level = n;
+  g.accumulation = s.accumulation;
+  g.prior_error_m = s.prior_error_m;
+  return g;
+}
+
+void box_init(double b[4]) {
+  b[0] = 1.0e300;
+  b[1] = 1.0e300;
+  b[2] = -1.0e300;
+  b[3] = -1.0e300;
+}
+void box_add(double b[4], double x, double y) {
+  if (x < b[0]) b[0] = x;
+  if (y < b[1]) b[1] = y;
+  if (x > b[2]) b[2] = x;
+  if (y > b[3]) b[3] = y;
+}
+bool box_valid(const double b[4]) { return b[0] <= b[2] && b[1] <= b[3]; }
+
+// Axis-aligned bounds, in the parent frame, of box `b` given in `frame`.
+void box_transform(const Pose2& frame, const double b[4], double out[4]) {
+  box_init(out);
+  const double xs[2] = {b[0], b[2]};
+  const double ys[2] = {b[1], b[3]};
+  for (double x : xs) {
+    for (double y : ys) {
+      double gx = 0.0;
+      double gy = 0.0;
+      frame.transform_point(x, y, gx, gy);
+      box_add(out, gx, gy);
+    }
+  }
+}
+
+}  // namespace
+
+double SdpStats::error_std_m() const {
+  if (error_samples < 2U) return 0.0;
+  const double n = static_cast<double>(error_samples);
+  const double m = error_sum_m / n;
+  const double v = error_sq_sum_m2 / n - m * m;
+  return v > 0.0 ? det::sqrt(v) : 0.0;
+}
+
+double SdpSlam::box_overlap_m2(const double a[4], const double b[4]) {
+  const double x0 = a[0] > b[0] ? a[0] : b[0];
+  const double y0 = a[1] > b[1] ? a[1] : b[1];
+  const double x1 = a[2] < b[2] ? a[2] : b[2];
+  const double y1 = a[3] < b[3] ? a[3] : b[3];
+  if (!(x1 > x0) || !(y1 > y0)) return 0.0;
+  return (x1 - x0) * (y1 - y0);
+}
+
+DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp) {
+  DpSlamOptions b = bottom;
+  const std::uint32_t n = b.particle_count;
+  // Anchored segments keep at most 2N-1 nodes each (prune bound); the restart needs N+1;
+  // one global-map root; headroom.
+  b.extra_ancestry_nodes = sdp.max_levels * 2U * n + n + 8U;
+  // Anchored leaves keep their uncommitted poses: at most N × segment length per segment.
+  b.extra_path_entries = (sdp.max_levels + 1U) * n * sdp.max_segment_scans;
+  return b;
+}
+
+std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const SdpOptions& s) {
+  if (!s.validate(nullptr, 0U)) return 0U;
+  const DpSlamOptions b = bottom_options_for(bottom_in, s);
+  const std::size_t fb = DpSlamFilter::required_arena_bytes(b);
+  if (fb == 0U) return 0U;
+  const std::size_t gb = SegmentGraph::required_bytes(graph_options(s, b.particle_count));
+  if (gb == 0U) return 0U;
+  const std::size_t n = b.particle_count;
+  const std::size_t t = s.top_particles;
+  const std::size_t L = s.max_levels;
+  const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
+  const std::size_t cs = coarse_side_cells(b, s);
+  std::size_t total = fb + gb + bytes_of<DpSlamFilter>(1U) + bytes_of<Icp2d>(1U) + bytes_of<Segmenter>(1U);
+  total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
+  total += bytes_of<Submap>(L * n) + bytes_of<Point2>(L * n * s.skeleton_points) + bytes_of<Level>(L);
+  total += bytes_of<Permanent>(s.max_permanent_submaps) + bytes_of<Point2>(s.max_permanent_submaps * std::size_t{s.skeleton_points});
+  total += 2U * bytes_of<std::uint16_t>(t * L) + bytes_of<double>(t) + bytes_of<std::uint8_t>(t) +
+           bytes_of<std::uint32_t>(t);
+  total += bytes_of<std::uint32_t>(L) + 2U * bytes_of<Pose2>(L) + bytes_of<Pose2>(n);
+  total += bytes_of<StampedPose>(ring_capacity_for(s));
+  total += bytes_of<CellObservation>(fine) + bytes_of<std::uint8_t>(fine) + bytes_of<CellState>(cs * cs);
+  return total + kSlack;
+}
+
+bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& arena, std::uint64_t seed) {
+  initialised_ = false;
+  if (!s.validate(why_, sizeof why_)) return false;
+  const DpSlamOptions b = bottom_options_for(bottom_in, s);
+  if (!b.validate(why_, sizeof why_)) return false;
+  const std::size_t need = required_arena_bytes(bottom_in, s);
+  if (need == 0U || arena.available_bytes() < need) {
+    std::snprintf(why_, sizeof why_, "arena too small: %zu bytes available, %zu needed", arena.available_bytes(), need);
+    return false;
+  }
+  const std::size_t used0 = arena.used_bytes();
+  options_ = s;
+  bottom_options_ = b;
+  n_bottom_ = b.particle_count;
+  n_top_ = s.top_particles;
+  if (n_bottom_ > capacity::kMaxPgsNodesPerLevel) {
+    std::snprintf(why_, sizeof why_, "filter.particles above the PGS nodes per level (%u)",
+                  capacity::kMaxPgsNodesPerLevel);
+    return false;
+  }
+  void* fmem = arena.allocate(sizeof(DpSlamFilter), alignof(DpSlamFilter));
+  void* imem = arena.allocate(sizeof(Icp2d), alignof(Icp2d));
+  void* smem = arena.allocate(sizeof(Segmenter), alignof(Segmenter));
+  if (fmem == nullptr || imem == nullptr || smem == nullptr) {
+    std::snprintf(why_, sizeof why_, "arena exhausted (filter objects)");
+    return false;
+  }
+  filter_ = new (fmem) DpSlamFilter();
+  icp_ = new (imem) Icp2d();
+  segmenter_ = new (smem) Segmenter(options_);
+  if (!filter_->init(b, arena, seed)) {
+    std::snprintf(why_, sizeof why_, "bottom filter: %s", filter_->why());
+    return false;
+  }
+  filter_->set_pose_sink(&ring_sink_);
+  if (!graph_.init(graph_options(s, n_bottom_), arena)) {
+    std::snprintf(why_, sizeof why_, "PGS init failed");
+    return false;
+  }
+  coarse_side_ = coarse_side_cells(b, s);
+  if (coarse_side_ > capacity::kMaxSkeletonPatchSide || !skeleton_.init(arena, coarse_side_, coarse_side_)) {
+    std::snprintf(why_, sizeof why_, "skeleton init failed (patch side %u cells)", coarse_side_);
+    return false;
+  }
+  const std::uint32_t L = s.max_levels;
+  submaps_ = arena.allocate_array<Submap>(std::size_t{L} * n_bottom_);
+  live_points_ = arena.allocate_array<Point2>(std::size_t{L} * n_bottom_ * s.skeleton_points);
+  levels_ = arena.allocate_array<Level>(L);
+  perm_ = arena.allocate_array<Permanent>(s.max_permanent_submaps);
+  perm_points_ = arena.allocate_array<Point2>(std::size_t{s.max_permanent_submaps} * s.skeleton_points);
+  choices_ = arena.allocate_array<std::uint16_t>(std::size_t{n_top_} * L);
+  scratch_choices_ = arena.allocate_array<std::uint16_t>(std::size_t{n_top_} * L);
+  error_ = arena.allocate_array<double>(n_top_);
+  has_error_ = arena.allocate_array<std::uint8_t>(n_top_);
+  order_ = arena.allocate_array<std::uint32_t>(n_top_);
+  chain_ = arena.allocate_array<std::uint32_t>(L);
+  frames_ = arena.allocate_array<Pose2>(L);
+  eval_frames_ = arena.allocate_array<Pose2>(L);
+  poses_scratch_ = arena.allocate_array<Pose2>(n_bottom_);
+  ring_capacity_ = ring_capacity_for(s);
+  ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
+  const std::uint32_t fs = fine_side_cells(b, s);
+  fine_cells_ = static_cast<std::size_t>(fs) * fs;
+  fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
+  fine_known_ = arena.allocate_array<std::uint8_t>(fine_cells_);
+  coarse_ = arena.allocate_array<CellState>(std::size_t{coarse_side_} * coarse_side_);
+  if (submaps_ == nullptr || live_points_ == nullptr || levels_ == nullptr || perm_ == nullptr ||
+      perm_points_ == nullptr || choices_ == nullptr || scratch_choices_ == nullptr || error_ == nullptr ||
+      has_error_ == nullptr || order_ == nullptr || chain_ == nullptr || frames_ == nullptr ||
+      eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
+      fine_known_ == nullptr || coarse_ == nullptr) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
+    return false;
+  }
+  for (std::size_t i = 0; i < std::size_t{L} * n_bottom_; ++i) submaps_[i] = Submap{};
+  for (std::uint32_t i = 0; i < L; ++i) levels_[i] = Level{};
+  for (std::uint32_t p = 0; p < n_top_; ++p) {
+    error_[p] = 0.0;
+    has_error_[p] = 0U;
+    order_[p] = p;
+  }
+  for (std::size_t i = 0; i < std::size_t{n_top_} * L; ++i) choices_[i] = 0U;
+  rng_.reseed(seed ^ 0x5D95E6A1C3B2F407ULL);
+  stats_ = SdpStats{};
+  arena_used_ = arena.used_bytes() - used0;
+  why_[0] = '\0';
+  initialised_ = true;
+  return true;
+}
+
+void SdpSlam::ring_push(std::int64_t stamp_us, const Pose2& pose) {
+  if (ring_count_ == ring_capacity_) {
+    ++stats_.pose_ring_dropped;
+    return;
+  }
+  ring_[(ring_head_ + ring_count_) % ring_capacity_] = StampedPose{stamp_us, pose};
+  ++ring_count_;
+  if (ring_count_ > stats_.pose_ring_peak) stats_.pose_ring_peak = ring_count_;
+}
+
+CellRect SdpSlam::rect_around(double x0, double y0, double x1, double y1, double pad_m) const {
+  const DpMap& map = filter_->map();
+  CellRect r{};
+  if (!(x0 <= x1 && y0 <= y1)) return r;
+  const double res = map.resolution_m();
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  auto cell = [res](double v, double o) {
+    const double c = (v - o) / res;
+    return c < -1.0e9 ? -1000000000 : (c > 1.0e9 ? 1000000000 : static_cast<std::int32_t>(c >= 0.0 ? c : c - 1.0));
+  };
+  std::int32_t ix0 = cell(x0 - pad_m, ox);
+  std::int32_t iy0 = cell(y0 - pad_m, oy);
+  std::int32_t ix1 = cell(x1 + pad_m, ox) + 1;
+  std::int32_t iy1 = cell(y1 + pad_m, oy) + 1;
+  if (ix0 < 0) ix0 = 0;
+  if (iy0 < 0) iy0 = 0;
+  if (ix1 > map.width_cells()) ix1 = map.width_cells();
+  if (iy1 > map.height_cells()) iy1 = map.height_cells();
+  if (ix1 <= ix0 || iy1 <= iy0) return r;
+  r.ix0 = ix0;
+  r.iy0 = iy0;
+  r.width = static_cast<std::uint32_t>(ix1 - ix0);
+  r.height = static_cast<std::uint32_t>(iy1 - iy0);
+  return r;
+}
+
+void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
+  double s = 0.0;
+  double q = 0.0;
+  std::uint32_t c = 0U;
+  for (std::uint32_t p = 0; p < n_top_; ++p) {
+    if (has_error_[p] == 0U) continue;
+    s += error_[p];
+    q += error_[p] * error_[p];
+    ++c;
+  }
+  const double m = c > 0U ? s / static_cast<double>(c) : 0.0;
+  const double v = c > 0U ? q / static_cast<double>(c) - m * m : 0.0;
+  if (mean_m != nullptr) *mean_m = m;
+  if (std_m != nullptr) *std_m = v > 0.0 ? det::sqrt(v) : 0.0;
+  if (count != nullptr) *count = c;
+}
+
+// ---- per scan -------------------------------------------------------------------------
+
+SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan) {
+  SdpStepResult result;
+  if (!initialised_) return result;
+  result.bottom = filter_->process(odom, scan);
+  if (result.bottom.status == StepResult::Status::kProcessed) {
+    const Pose2 best = filter_->best_pose();
+    if (!started_) {
+      started_ = true;
+      segment_start_stamp_us_ = scan.stamp_us - 1;  // the first scan belongs to segment 0
+      segment_start_pose_ = Pose2{};
+      segmenter_->start(scan.stamp_us, odom.pose);
+      box_init(seg_box_);
+    }
+    last_processed_stamp_us_ = scan.stamp_us;
+    box_add(seg_box_, best.x_m, best.y_m);
+    const std::uint32_t n = filter_->particle_count();
+    for (std::uint32_t i = 0; i < n; ++i) poses_scratch_[i] = filter_->particle_pose(i);
+    const SegmentEnd end = segmenter_->on_processed(scan.stamp_us, odom.pose, poses_scratch_, n);
+    if (end != SegmentEnd::kNone) {
+      const std::uint64_t before = stats_.segments;
+      segment(scan.stamp_us);
+      if (stats_.segments != before) {
+        result.segmented = end;
+        segmenter_->start(scan.stamp_us, odom.pose);
+      }
+    }
+  }
+  // Top-level work within the budget: anchorage first (the evaluation needs skeletons).
+  result.work_cells = do_work(options_.work_cells_per_scan);
+  bool work_pending = false;
+  for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && !work_pending; ++lv) {
+    for (std::uint32_t k = 0; k < levels_[slot(lv)].count; ++k) {
+      if (!submap(lv, k).skeleton_done) {
+        work_pending = true;
+        break;
+      }
+    }
+  }
+  if (round_active_ && !work_pending) {
+    for (std::uint32_t e = 0; e < options_.evaluations_per_scan && eval_cursor_ < n_top_; ++e) {
+      evaluate(eval_cursor_++);
+      ++result.evaluations;
+    }
+    if (eval_cursor_ >= n_top_) end_round(scan.stamp_us, true);
+  }
+  result.pose = current_frame_.compose(result.bottom.pose);
+  return result;
+}
+
+void SdpSlam::finish() {
+  if (!initialised_) return;
+  while (do_work(0xFFFFFFFFU) > 0U) {
+  }
+}
+
+// ---- segmentation, anchorage, restart (lines 4-8) --------------------------------------
+
+void SdpSlam::segment(std::int64_t stamp_us) {
+  const std::uint32_t n = filter_->particle_count();
+  // Room in the PGS first (bounded memory): the oldest level becomes permanent.
+  if (graph_.live_level_count() >= options_.max_levels) make_oldest_permanent();
+  NodeId nodes[capacity::kMaxPgsNodesPerLevel];
+  std::uint32_t bottom_best = 0U;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    nodes[i] = filter_->particle_node(i);
+    poses_scratch_[i] = filter_->particle_pose(i);
+    if (nodes[i] == filter_->best_node()) bottom_best = i;
+  }
+  const Pose2 restart_pose = filter_->best_pose();
+  // Line 6 before line 8: if the restart is refused nothing was anchored yet.
+  if (!filter_->restart_segment(restart_pose)) {
+    ++stats_.restart_refused;
+    return;
+  }
+  PgsNodeInput in[capacity::kMaxPgsNodesPerLevel];
+  for (std::uint32_t i = 0; i < n; ++i) {
+    in[i].particle_id = nodes[i];
+    in[i].initial_pose = segment_start_pose_;
+    in[i].final_pose = poses_scratch_[i];
+  }
+  const PgsLevelResult added = graph_.add_level(in, n);
+  if (added.status != PgsStatus::kOk) {
+    // Cannot happen after make_oldest_permanent; the anchored nodes are released so that
+    // nothing leaks, and the segment's submaps are lost (counted).
+    ++stats_.pgs_refused;
+    for (std::uint32_t i = 0; i < n; ++i) filter_->release_anchored(nodes[i]);
+    segment_start_pose_ = restart_pose;
+    segment_start_stamp_us_ = stamp_us;
+    box_init(seg_box_);
+    return;
+  }
+  const std::uint32_t level = added.level;
+  Level& lv = levels_[slot(level)];
+  lv.start_stamp_us = segment_start_stamp_us_;
+  lv.end_stamp_us = stamp_us;
+  lv.count = n;
+  const double pad = bottom_options_.beam.max_update_range_m;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Submap& sm = submap(level, i);
+    sm = Submap{};
+    sm.node = nodes[i];
+    sm.initial = segment_start_pose_;
+    sm.final_pose = poses_scratch_[i];
+    double b[4];
+    box_init(b);
+    for_each_level_pose(level, nodes[i], [&b](std::int64_t, const Pose2& p) { box_add(b, p.x_m, p.y_m); });
+    box_add(b, sm.final_pose.x_m, sm.final_pose.y_m);
+    box_add(b, sm.initial.x_m, sm.initial.y_m);
+    sm.map_rect = rect_around(b[0], b[1], b[2], b[3], pad);
+    sm.path_rect = rect_around(b[0], b[1], b[2], b[3], options_.skeleton_pad_m);
+    sm.skeleton_done = false;
+  }
+  ++stats_.segments;
+  if (graph_.live_level_count() > stats_.max_live_levels) stats_.max_live_levels = graph_.live_level_count();
+  segment_start_pose_ = restart_pose;
+  segment_start_stamp_us_ = stamp_us;
+  box_init(seg_box_);
+  box_add(seg_box_, restart_pose.x_m, restart_pose.y_m);
+
+  // Lines 10-11: resample with elitism, extend to the new level, start evaluating.
+  if (round_active_) end_round(stamp_us, false);  // a round cut short keeps what it measured
+  if (level > graph_.first_live_level()) resample_and_diversify();
+  extend_to_level(level, bottom_best);
+  rounds_in_segment_ = 0U;
+  round_active_ = true;
+  eval_cursor_ = 0U;
+  round_sum_ = 0.0;
+  round_sq_ = 0.0;
+  round_samples_ = 0U;
+  update_best();
+}
+
+void SdpSlam::make_oldest_permanent() {
+  const std::uint32_t level = graph_.first_live_level();
+  if (!graph_.is_live(level)) return;
+  // Pending work on this level first (its skeletons, the previous transfer).
+  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+  const std::uint32_t count = levels_[slot(level)].count;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    if (!submap(level, k).skeleton_done) extract_skeleton(level, k);
+  }
+  rank_particles();
+  const std::uint32_t chosen = choice(order_[0], level);
+  const PgsPermanentResult r = graph_.make_oldest_permanent(chosen);
+  if (r.status != PgsStatus::kOk) return;
+  ++stats_.levels_made_permanent;
+  const Submap& sm = submap(level, chosen);
+  // Its poses, in the global frame.
+  if (permanent_sink_ != nullptr) {
+    for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) {
+      permanent_sink_->on_committed(s, r.frame_in_global.compose(p));
+    });
+  }
+  // Its skeleton joins the permanent ring (the oldest is forgotten when full).
+  if (perm_count_ == options_.max_permanent_submaps) {
+    perm_head_ = (perm_head_ + 1U) % options_.max_permanent_submaps;
+    --perm_count_;
+    ++stats_.permanent_forgotten;
+  }
+  const std::uint32_t pi = (perm_head_ + perm_count_) % options_.max_permanent_submaps;
+  Permanent& pm = perm_[pi];
+  pm.frame_in_global = r.frame_in_global;
+  for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
+  pm.level = level;
+  pm.point_count = sm.point_count;
+  const Point2* src = live_points(level, chosen);
+  Point2* dst = perm_points(pi);
+  for (std::uint32_t i = 0; i < sm.point_count; ++i) dst[i] = src[i];
+  ++perm_count_;
+  // The other submaps of the level are released now; the chosen one once its map has
+  // been copied into the global map node.
+  for (std::uint32_t k = 0; k < count; ++k) {
+    if (k == chosen) continue;
+    if (filter_->release_anchored(submap(level, k).node)) ++stats_.submaps_released;
+  }
+  if (global_node_ == kNoNode) global_node_ = filter_->create_anchored_root();
+  transfer_ = Transfer{};
+  transfer_.active = true;
+  transfer_.node = sm.node;
+  transfer_.frame = r.frame_in_global;
+  transfer_.rect = sm.map_rect;
+  transfer_.next_row = 0U;
+  // Committed poses of the level leave the ring (they are the oldest).
+  const std::int64_t end = levels_[slot(level)].end_stamp_us;
+  while (ring_count_ > 0U && ring_[ring_head_].stamp_us <= end) {
+    ring_head_ = (ring_head_ + 1U) % ring_capacity_;
+    --ring_count_;
+  }
+  levels_[slot(level)].count = 0U;
+}
+
+std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
+  if (!transfer_.active) return 0U;
+  const DpMap& map = filter_->map();
+  const CellRect& r = transfer_.rect;
+  std::uint32_t used = 0U;
+  if (r.width == 0U || global_node_ == kNoNode) {
+    transfer_.next_row = r.height;
+  }
+  while (transfer_.next_row < r.height && used < budget_cells) {
+    std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / r.width);
+    if (rows == 0U) rows = 1U;
+    if (rows > r.height - transfer_.next_row) rows = r.height - transfer_.next_row;
+    CellRect strip = r;
+    strip.iy0 = r.iy0 + static_cast<std::int32_t>(transfer_.next_row);
+    strip.height = rows;
+    if (static_cast<std::size_t>(strip.width) * rows > fine_cells_) strip.width = static_cast<std::uint32_t>(fine_cells_);
+    map.fill_rect(transfer_.node, strip, fine_values_, fine_known_);
+    for (std::uint32_t y = 0; y < rows; ++y) {
+      for (std::uint32_t x = 0; x < strip.width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * strip.width + x;
+        if (fine_known_[i] == 0U) continue;
+        double cx = 0.0;
+        double cy = 0.0;
+        map.cell_center(strip.ix0 + static_cast<std::int32_t>(x), strip.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
+        double gx = 0.0;
+        double gy = 0.0;
+        transfer_.frame.transform_point(cx, cy, gx, gy);
+        std::int32_t gix = 0;
+        std::int32_t giy = 0;
+        ++stats_.map_transfer_cells;
+        if (!map.world_to_cell(gx, gy, &gix, &giy) ||
+            !filter_->add_to_anchored(global_node_, gix, giy, fine_values_[i].hits, fine_values_[i].misses)) {
+          ++stats_.map_transfer_dropped;
+        }
+      }
+    }
+    transfer_.next_row += rows;
+    used += strip.width * rows;
+  }
+  if (transfer_.next_row >= r.height) {
+    if (filter_->release_anchored(transfer_.node)) ++stats_.submaps_released;
+    transfer_ = Transfer{};
+  }
+  return used > 0U ? used : 1U;
+}
+
+std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
+  std::uint32_t used = 0U;
+  // Skeletons of the live levels, oldest first.
+  for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
+    for (std::uint32_t k = 0; k < levels_[slot(lv)].count && used < budget_cells; ++k) {
+      if (!submap(lv, k).skeleton_done) used += extract_skeleton(lv, k);
+    }
+  }
+  if (used < budget_cells && transfer_.active) used += transfer_rows(budget_cells - used);
+  return used;
+}
+
+std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node) {
+  Submap& sm = submap(level, node);
+  sm.skeleton_done = true;
+  sm.point_count = 0U;
+  box_init(sm.box);
+  CellRect r = sm.path_rect;
+  const std::uint32_t d = options_.skeleton_downsample;
+  const std::uint32_t max_fine = (coarse_side_ - 2U) * d;
+  // Bounded patch: centred crop of the padded path bounds.
+  if (r.width > max_fine) {
+    r.ix0 += static_cast<std::int32_t>((r.width - max_fine) / 2U);
+    r.width = max_fine;
+  }
+  if (r.height > max_fine) {
+    r.iy0 += static_cast<std::int32_t>((r.height - max_fine) / 2U);
+    r.height = max_fine;
+  }
+  if (r.width == 0U || r.height == 0U) return 1U;
+  const DpMap& map = filter_->map();
+  map.fill_rect(sm.node, r, fine_values_, fine_known_);
+  const std::uint32_t cw = (r.width + d - 1U) / d;
+  const std::uint32_t ch = (r.height + d - 1U) / d;
+  for (std::uint32_t cy = 0; cy < ch; ++cy) {
+    for (std::uint32_t cx = 0; cx < cw; ++cx) {
+      bool occ = false;
+      bool fre = false;
+      for (std::uint32_t dy = 0; dy < d; ++dy) {
+        const std::uint32_t y = cy * d + dy;
+        if (y >= r.height) break;
+        for (std::uint32_t dx = 0; dx < d; ++dx) {
+          const std::uint32_t x = cx * d + dx;
+          if (x >= r.width) break;
+          const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
+          if (fine_known_[i] == 0U) continue;
+          const double p = filter_->occupancy(fine_values_[i]);
+          if (p >= options_.occupied_threshold) occ = true;
+          else if (p <= options_.free_threshold) fre = true;
+        }
+      }
+      coarse_[static_cast<std::size_t>(cy) * cw + cx] = occ ? CellState::kOccupied : (fre ? CellState::kFree : CellState::kUnknown);
+    }
+  }
+  GridPatchView patch;
+  patch.width = cw;
+  patch.height = ch;
+  patch.resolution_m = map.resolution_m() * static_cast<double>(d);
+  patch.origin_x_m = map.options().origin_x_m + static_cast<double>(r.ix0) * map.resolution_m();
+  patch.origin_y_m = map.options().origin_y_m + static_cast<double>(r.iy0) * map.resolution_m();
+  patch.cells = coarse_;
+  SkeletonOptions so;
+  so.min_clearance_m = options_.skeleton_min_clearance_m;
+  so.max_points = options_.skeleton_points;
+  Point2* out = live_points(level, node);
+  const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
+  ++stats_.skeletons;
+  if (res.status == SkeletonResult::Status::kOk) {
+    sm.point_count = res.point_count;
+    stats_.skeleton_truncated_points += res.truncated_count;
+    for (std::uint32_t i = 0; i < sm.point_count; ++i) box_add(sm.box, out[i].x_m, out[i].y_m);
+  }
+  return r.width * r.height;
+}
+
+// ---- top level (lines 10-12) -----------------------------------------------------------
+
+double SdpSlam::key(std::uint32_t p) const { return has_error_[p] != 0U ? error_[p] : options_.prior_error_m; }
+
+void SdpSlam::rank_particles() {
+  for (std::uint32_t i = 0; i < n_top_; ++i) order_[i] = i;
+  // Insertion sort: stable, deterministic, T <= 4096.
+  for (std::uint32_t i = 1; i < n_top_; ++i) {
+    const std::uint32_t v = order_[i];
+    const double kv = key(v);
+    std::uint32_t j = i;
+    while (j > 0U && key(order_[j - 1U]) > kv) {
+      order_[j] = order_[j - 1U];
+      --j;
+    }
+    order_[j] = v;
+  }
+}
+
+void SdpSlam::resample_and_diversify() {
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t end = graph_.level_end();
+  if (end <= first) return;
+  rank_particles();
+  const std::uint32_t L = options_.max_levels;
+  std::uint32_t elite = static_cast<std::uint32_t>(options_.elite_fraction * static_cast<double>(n_top_));
+  const std::uint32_t worst = static_cast<std::uint32_t>(options_.worst_fraction * static_cast<double>(n_top_));
+  if (elite > n_top_) elite = n_top_;
+  const std::uint32_t best = order_[0];
+  // Worst ranks become copies of the elite (of the best when there is no elite).
+  for (std::uint32_t k = 0; k < worst && k < n_top_ - elite; ++k) {
+    const std::uint32_t dst = order_[n_top_ - 1U - k];
+    const std::uint32_t src = order_[elite > 0U ? k % elite : 0U];
+    if (dst == src) continue;
+    for (std::uint32_t s = 0; s < L; ++s) choices_[dst * L + s] = choices_[src * L + s];
+    error_[dst] = error_[src];
+    has_error_[dst] = has_error_[src];
+  }
+  // Everyone but the elite diversifies.
+  std::uint32_t lo = first;
+  if (options_.topology == TopologyMode::kSegSlam && end - first > options_.segslam_window) {
+    lo = end - options_.segslam_window;
+  }
+  for (std::uint32_t r = elite; r < n_top_; ++r) {
+    const std::uint32_t p = order_[r];
+    if (options_.topology == TopologyMode::kSegSlam) {
+      // Local analysis: chains before the window follow the best sample.
+      for (std::uint32_t lv = first; lv < lo; ++lv) choice(p, lv) = choice(best, lv);
+    }
+    for (std::uint32_t k = 0; k < options_.diversify_levels; ++k) {
+      const std::uint32_t lv = lo + rng_.below(end - lo);
+      const double u = rng_.uniform();
+      PgsPick pick = lv == first ? graph_.sample_first(u) : graph_.sample_next(lv - 1U, choice(p, lv - 1U), u);
+      if (pick.status == PgsStatus::kOk) choice(p, lv) = static_cast<std::uint16_t>(pick.node);
+    }
+  }
+}
+
+void SdpSlam::extend_to_level(std::uint32_t level, std::uint32_t bottom_best) {
+  rank_particles();
+  std::uint32_t follow =
+      static_cast<std::uint32_t>(options_.follow_best_fraction * static_cast<double>(n_top_) + 0.999999);
+  if (follow > n_top_) follow = n_top_;
+  for (std::uint32_t r = 0; r < n_top_; ++r) {
+    const std::uint32_t p = order_[r];
+    if (r < follow) {
+      choice(p, level) = static_cast<std::uint16_t>(bottom_best);
+      continue;
+    }
+    const double u = rng_.uniform();
+    const PgsPick pick = level == graph_.first_live_level() ? graph_.sample_first(u)
+                                                            : graph_.sample_next(level - 1U, choice(p, level - 1U), u);
+    choice(p, level) = static_cast<std::uint16_t>(pick.status == PgsStatus::kOk ? pick.node : bottom_best);
+  }
+}
+
+void SdpSlam::evaluate(std::uint32_t p) {
+  ++stats_.evaluations;
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t count = graph_.live_level_count();
+  if (count == 0U) return;
+  for (std::uint32_t i = 0; i < count; ++i) chain_[i] = choice(p, first + i);
+  if (graph_.compose_chain(chain_, count, eval_frames_) != PgsStatus::kOk) return;
+  // Candidate pairs: (older, newer), non-adjacent, largest box overlap first.
+  struct Cand {
+    double area;
+    std::int32_t older;  // live level index i (>= 0) or -(permanent ring index + 1)
+    std::uint32_t newer; // live level index
+  };
+  Cand best[64];
+  std::uint32_t nbest = 0U;
+  const std::uint32_t kmax = options_.max_pairs_per_sample;
+  auto consider = [&](double area, std::int32_t older, std::uint32_t newer) {
+    if (area < options_.min_overlap_m2 || area <= 0.0) return;
+    std::uint32_t pos = nbest;
+    while (pos > 0U && best[pos - 1U].area < area) --pos;
+    if (pos >= kmax) return;
+    const std::uint32_t last = nbest < kmax ? nbest : kmax - 1U;
+    for (std::uint32_t k = last; k > pos; --k) best[k] = best[k - 1U];
+    best[pos] = Cand{area, older, newer};
+    if (nbest < kmax) ++nbest;
+  };
+  const double m = options_.overlap_margin_m;
+  double gbox[capacity::kMaxPgsLevels][4];
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const Submap& sm = submap(first + i, chain_[i]);
+    if (!sm.skeleton_done || sm.point_count < options_.icp.min_pairs || !box_valid(sm.box)) {
+      gbox[i][0] = 1.0;
+      gbox[i][2] = -1.0;
+      gbox[i][1] = 1.0;
+      gbox[i][3] = -1.0;
+      continue;
+    }
+    box_transform(eval_frames_[i], sm.box, gbox[i]);
+    gbox[i][0] -= m;
+    gbox[i][1] -= m;
+    gbox[i][2] += m;
+    gbox[i][3] += m;
+  }
+  for (std::uint32_t j = 0; j < count; ++j) {
+    if (!box_valid(gbox[j])) continue;
+    for (std::uint32_t i = 0; i + 2U <= j; ++i) {
+      if (box_valid(gbox[i])) consider(box_overlap_m2(gbox[i], gbox[j]), static_cast<std::int32_t>(i), j);
+    }
+    for (std::uint32_t k = 0; k < perm_count_; ++k) {
+      const std::uint32_t pi = (perm_head_ + k) % options_.max_permanent_submaps;
+      const Permanent& pm = perm_[pi];
+      if (pm.level + 1U >= first + j || pm.point_count < options_.icp.min_pairs) continue;  // adjacent
+      double pb[4];
+      box_transform(pm.frame_in_global, pm.box, pb);
+      consider(box_overlap_m2(pb, gbox[j]), -static_cast<std::int32_t>(pi) - 1, j);
+    }
+  }
+  if (nbest == 0U) return;  // no overlap: the weight is not changed (§IV)
+  double sum = 0.0;
+  double pairs = 0.0;
+  std::uint32_t lo = first + count;
+  std::uint32_t hi = first;
+  for (std::uint32_t k = 0; k < nbest; ++k) {
+    const Cand& c = best[k];
+    const Submap& sn = submap(first + c.newer, chain_[c.newer]);
+    const Point2* target = nullptr;
+    std::uint32_t tcount = 0U;
+    Pose2 tframe;
+    std::uint32_t older_level = first;
+    if (c.older >= 0) {
+      const std::uint32_t i = static_cast<std::uint32_t>(c.older);
+      const Submap& so = submap(first + i, chain_[i]);
+      target = live_points(first + i, chain_[i]);
+      tcount = so.point_count;
+      tframe = eval_frames_[i];
+      older_level = first + i;
+    } else {
+      const std::uint32_t pi = static_cast<std::uint32_t>(-c.older - 1);
+      target = perm_points(pi);
+      tcount = perm_[pi].point_count;
+      tframe = perm_[pi].frame_in_global;
+    }
+    const Pose2 guess = tframe.inverse().compose(eval_frames_[c.newer]);
+    const Icp2dResult r = icp_->match(target, tcount, live_points(first + c.newer, chain_[c.newer]), sn.point_count,
+                                      guess, options_.icp);
+    double e = 0.0;
+    double w = 0.0;
+    if (r.usable() && r.matched_pairs > 0U) {
+      ++stats_.icp_matches;
+      e = r.mean_nn_error_m;
+      w = static_cast<double>(r.matched_pairs);
+    } else if (r.status == Icp2dResult::Status::kInsufficientOverlap) {
+      ++stats_.icp_failures;
+      e = options_.icp.max_correspondence_m;
+      w = static_cast<double>(options_.icp.min_pairs);
+    } else {
+      continue;
+    }
+    sum += e * w;
+    pairs += w;
+    if (older_level < lo) lo = older_level;
+    if (first + c.newer > hi) hi = first + c.newer;
+  }
+  if (!(pairs > 0.0)) return;
+  const double err = sum / pairs;
+  error_[p] = err;
+  has_error_[p] = 1U;
+  ++stats_.evaluations_with_overlap;
+  stats_.error_sum_m += err;
+  stats_.error_sq_sum_m2 += err * err;
+  ++stats_.error_samples;
+  round_sum_ += err;
+  round_sq_ += err * err;
+  ++round_samples_;
+  // Line 12: the error goes to the PGS edges of the combination it measured.
+  if (hi > lo) graph_.record_chain_error(lo, chain_ + (lo - first), hi - lo + 1U, err);
+}
+
+void SdpSlam::end_round(std::int64_t stamp_us, bool may_continue) {
+  round_active_ = false;
+  ++stats_.rounds;
+  ++rounds_in_segment_;
+  const bool overlap = round_samples_ > 0U;
+  if (overlap) {
+    ++stats_.rounds_with_overlap;
+    const double n = static_cast<double>(round_samples_);
+    const double mean = round_sum_ / n;
+    const double v = round_sq_ / n - mean * mean;
+    if (listener_ != nullptr) listener_->on_round(stamp_us, mean, v > 0.0 ? det::sqrt(v) : 0.0, round_samples_);
+  }
+  update_best();
+  if (may_continue && overlap && rounds_in_segment_ < options_.rounds_per_segment) {
+    resample_and_diversify();
+    update_best();
+    round_active_ = true;
+    eval_cursor_ = 0U;
+    round_sum_ = 0.0;
+    round_sq_ = 0.0;
+    round_samples_ = 0U;
+  }
+}
+
+void SdpSlam::update_best() {
+  rank_particles();
+  best_top_ = order_[0];
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t count = graph_.live_level_count();
+  if (count == 0U) {
+    current_frame_ = Pose2{};
+    return;
+  }
+  for (std::uint32_t i = 0; i < count; ++i) chain_[i] = choice(best_top_, first + i);
+  if (graph_.compose_chain(chain_, count, frames_) != PgsStatus::kOk) return;
+  const Submap& last = submap(first + count - 1U, chain_[count - 1U]);
+  // The current segment starts where the last chosen submap ends (Fig. 3 (l)).
+  current_frame_ = frames_[count - 1U].compose(last.final_pose.compose(segment_start_pose_.inverse()));
+}
+
+}  // namespace sdpslam

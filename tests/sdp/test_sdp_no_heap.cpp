@@ -1,0 +1,50 @@
+// SDP-SLAM never touches the heap after init: a run over many segments, with a full PGS
+// whose oldest levels become permanent, under the allocation counter.
+#include <CppUTest/TestHarness.h>
+
+#include "alloc_counter.h"
+#include "sdp_harness.h"
+
+using namespace sdpslam;
+
+namespace {
+class CountingSink final : public PoseSink {
+ public:
+  void on_committed(std::int64_t, const Pose2&) override { ++count; }
+  std::uint64_t count = 0;
+};
+class CountingListener final : public TopLevelListener {
+ public:
+  void on_round(std::int64_t, double, double, std::uint32_t) override { ++count; }
+  std::uint64_t count = 0;
+};
+}  // namespace
+
+TEST_GROUP(SdpNoHeap){};
+
+TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) {
+  CHECK_TRUE(sdpslam::test::allocation_counting_active());
+  const test::ScanSet set(3);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 9));
+  CountingSink sink;
+  CountingListener listener;
+  rig.slam->set_permanent_sink(&sink);
+  rig.slam->set_listener(&listener);
+  double checksum = 0.0;
+  {
+    sdpslam::test::AllocationScope scope;
+    for (std::size_t i = 0; i < set.scans.size(); ++i) {
+      const SdpStepResult r = rig.slam->process(set.odom(i), *set.scans[i]);
+      checksum += r.pose.x_m;
+    }
+    rig.slam->finish();
+    rig.slam->for_each_best_pose([&](std::int64_t, const Pose2& p) { checksum += p.y_m; });
+    LONGS_EQUAL(0, scope.allocations());
+  }
+  CHECK(checksum == checksum);
+  CHECK(rig.slam->stats().segments > 8U);
+  CHECK(rig.slam->stats().levels_made_permanent > 0U);
+  CHECK(rig.slam->stats().evaluations > 0U);
+  CHECK(sink.count > 0U);
+}

@@ -1,0 +1,102 @@
+// Anchorage and restart of the bottom level (Algorithm 1 lines 5-6) through the
+// DpSlamFilter API that SDP-SLAM uses.
+#include <CppUTest/TestHarness.h>
+
+#include "../dpslam_filter/filter_harness.h"
+
+using namespace sdpslam;
+
+TEST_GROUP(SdpRestart){};
+
+TEST(SdpRestart, restart_before_the_first_scan_is_refused) {
+  test::FilterRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(4), 1));
+  CHECK_FALSE(rig.filter->restart_segment(Pose2{}));
+  LONGS_EQUAL(1, rig.filter->restart_refused_count());
+}
+
+TEST(SdpRestart, restart_anchors_the_old_nodes_and_starts_every_particle_at_one_pose) {
+  DpSlamOptions o = test::sim_options(4);
+  o.extra_ancestry_nodes = 32U;
+  test::FilterRig rig;
+  CHECK_TRUE(rig.init(o, 3));
+  const test::SimRun run = test::make_loop(1);
+  const auto world = test::room_world();
+  for (std::size_t i = 0; i < 60; ++i) rig.step(run, world, i);
+  NodeId old_nodes[4];
+  CellRect rect;
+  CHECK_TRUE(rig.filter->map().touched_bounds(&rect));
+  std::uint32_t old_known[4];
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    old_nodes[i] = rig.filter->particle_node(i);
+    old_known[i] = 0U;
+    rig.filter->map().for_each_known_cell(old_nodes[i], [&](std::int32_t, std::int32_t, const CellObservation&) { ++old_known[i]; });
+    CHECK(old_known[i] > 100U);
+  }
+  const Pose2 start{1.0, 2.0, 0.5};
+  CHECK_TRUE(rig.filter->restart_segment(start));
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const Pose2 p = rig.filter->particle_pose(i);
+    DOUBLES_EQUAL(start.x_m, p.x_m, 0.0);
+    DOUBLES_EQUAL(start.heading_rad, p.heading_rad, 0.0);
+    // New particles do not descend from the anchored nodes: their maps are independent.
+    CHECK_FALSE(rig.filter->tree().is_ancestor_or_self(old_nodes[0], rig.filter->particle_node(i)));
+    // Anchored nodes stay active and keep their whole map.
+    CHECK_TRUE(rig.filter->tree().is_active(old_nodes[i]));
+    std::uint32_t known = 0U;
+    rig.filter->map().for_each_known_cell(old_nodes[i], [&](std::int32_t, std::int32_t, const CellObservation&) { ++known; });
+    LONGS_EQUAL(old_known[i], known);
+  }
+  CHECK_TRUE(rig.filter->tree().invariants_hold());
+  CHECK_TRUE(rig.filter->map().invariants_hold());
+  // The new submap starts with the last scan only: far fewer cells than the old ones.
+  std::uint32_t fresh = 0U;
+  rig.filter->map().for_each_known_cell(rig.filter->particle_node(0), [&](std::int32_t, std::int32_t, const CellObservation&) { ++fresh; });
+  CHECK(fresh > 0U);
+  CHECK(fresh < old_known[0]);
+  // Processing continues on the new roots.
+  for (std::size_t i = 60; i < 100; ++i) rig.step(run, world, i);
+  CHECK_TRUE(rig.filter->tree().invariants_hold());
+  // The old nodes can no longer change.
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    std::uint32_t known = 0U;
+    rig.filter->map().for_each_known_cell(old_nodes[i], [&](std::int32_t, std::int32_t, const CellObservation&) { ++known; });
+    LONGS_EQUAL(old_known[i], known);
+  }
+}
+
+TEST(SdpRestart, release_refuses_current_particles_and_frees_anchored_observations) {
+  DpSlamOptions o = test::sim_options(4);
+  o.extra_ancestry_nodes = 32U;
+  test::FilterRig rig;
+  CHECK_TRUE(rig.init(o, 5));
+  const test::SimRun run = test::make_loop(1);
+  const auto world = test::room_world();
+  for (std::size_t i = 0; i < 40; ++i) rig.step(run, world, i);
+  NodeId anchored[4];
+  for (std::uint32_t i = 0; i < 4; ++i) anchored[i] = rig.filter->particle_node(i);
+  CHECK_TRUE(rig.filter->restart_segment(rig.filter->best_pose()));
+  CHECK_FALSE(rig.filter->release_anchored(rig.filter->particle_node(0)));
+  CHECK_FALSE(rig.filter->release_anchored(kNoNode));
+  const std::uint32_t before = rig.filter->map().observations_used();
+  for (std::uint32_t i = 0; i < 4; ++i) CHECK_TRUE(rig.filter->release_anchored(anchored[i]));
+  CHECK(rig.filter->map().observations_used() < before);
+  CHECK_FALSE(rig.filter->tree().contains(anchored[0]) && rig.filter->tree().is_active(anchored[0]));
+  CHECK_TRUE(rig.filter->tree().invariants_hold());
+  CHECK_TRUE(rig.filter->map().invariants_hold());
+}
+
+TEST(SdpRestart, restart_without_room_for_the_new_particles_changes_nothing) {
+  DpSlamOptions o = test::sim_options(4);  // no extra nodes: 12 nodes in all
+  test::FilterRig rig;
+  CHECK_TRUE(rig.init(o, 5));
+  const test::SimRun run = test::make_loop(1);
+  const auto world = test::room_world();
+  for (std::size_t i = 0; i < 40; ++i) rig.step(run, world, i);
+  CHECK_TRUE(rig.filter->restart_segment(rig.filter->best_pose()));  // 4 anchored + 5 new
+  CHECK_FALSE(rig.filter->restart_segment(rig.filter->best_pose()));  // no room for 5 more
+  LONGS_EQUAL(1, rig.filter->restart_refused_count());
+  CHECK_TRUE(rig.filter->tree().invariants_hold());
+  const StepResult r = rig.step(run, world, 41);
+  CHECK(r.status != StepResult::Status::kNotInitialised);
+}

@@ -1,0 +1,216 @@
+// SDP-SLAM end to end on the synthetic room loop: segments, PGS levels, permanence,
+// evaluation of overlapping submaps at loop closure, exhaustion, determinism.
+#include <CppUTest/TestHarness.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "sdp_harness.h"
+
+using namespace sdpslam;
+
+namespace {
+
+struct Trace {
+  std::vector<std::int64_t> stamps;
+  std::vector<Pose2> poses;
+};
+
+// Runs `loops` loops; returns permanent + live trajectory.
+Trace run_sdp(test::SdpRig& rig, const test::ScanSet& set, test::CollectPoses* sink) {
+  rig.slam->set_permanent_sink(sink);
+  for (std::size_t i = 0; i < set.scans.size(); ++i) rig.slam->process(set.odom(i), *set.scans[i]);
+  rig.slam->finish();
+  Trace t;
+  t.stamps = sink->stamps;
+  t.poses = sink->poses;
+  rig.slam->for_each_best_pose([&](std::int64_t s, const Pose2& p) {
+    t.stamps.push_back(s);
+    t.poses.push_back(p);
+  });
+  return t;
+}
+
+}  // namespace
+
+TEST_GROUP(SdpSlam){};
+
+TEST(SdpSlam, init_refuses_invalid_options_and_a_small_arena) {
+  SdpOptions s = test::small_sdp_options();
+  s.top_particles = 0U;
+  test::SdpRig rig;
+  CHECK_FALSE(rig.init(test::sim_options(5), s, 1));
+  CHECK(std::strstr(rig.slam->why(), "top_particles") != nullptr);
+  const SdpOptions ok = test::small_sdp_options();
+  std::vector<unsigned char> small(SdpSlam::required_arena_bytes(test::sim_options(5), ok) / 2U);
+  Arena arena(small.data(), small.size());
+  SdpSlam slam2;
+  CHECK_FALSE(slam2.init(test::sim_options(5), ok, arena, 1));
+  CHECK(std::strstr(slam2.why(), "arena") != nullptr);
+}
+
+TEST(SdpSlam, a_long_run_fills_the_pgs_and_makes_old_levels_permanent) {
+  const test::ScanSet set(3);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 11));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(rig, set, &sink);
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.segments > 8U);
+  LONGS_EQUAL(4, st.max_live_levels);
+  CHECK(st.levels_made_permanent > 0U);
+  LONGS_EQUAL(st.segments - st.levels_made_permanent, rig.slam->graph().live_level_count());
+  // Every permanent level released its N submaps (N-1 at once, the chosen one after its
+  // map went into the global map).
+  LONGS_EQUAL(st.levels_made_permanent * 5U, st.submaps_released);
+  CHECK(st.map_transfer_cells > 0U);
+  LONGS_EQUAL(0, st.pgs_refused);
+  LONGS_EQUAL(0, st.pose_ring_dropped);
+  CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
+  CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+  CHECK_TRUE(rig.slam->graph().invariants_hold());
+  // Permanent poses first, then the live ones: stamps strictly increase, and every
+  // processed scan has a pose.
+  CHECK(sink.stamps.size() > 0U);
+  for (std::size_t i = 1; i < t.stamps.size(); ++i) CHECK(t.stamps[i] > t.stamps[i - 1U]);
+  CHECK(t.stamps.size() >= rig.slam->bottom().stats().processed - 1U);
+  CHECK(t.stamps.size() <= rig.slam->bottom().stats().processed);
+}
+
+TEST(SdpSlam, loop_closures_are_evaluated_and_recorded_in_the_pgs) {
+  const test::ScanSet set(2);
+  test::SdpRig rig;
+  SdpOptions s = test::small_sdp_options();
+  s.max_levels = 16U;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 12));
+  test::CollectPoses sink;
+  run_sdp(rig, set, &sink);
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.skeletons >= st.segments * 5U);
+  CHECK(st.evaluations_with_overlap > 0U);
+  CHECK(st.icp_matches > 0U);
+  CHECK(st.error_samples > 0U);
+  CHECK(st.error_mean_m() > 0.0 && st.error_mean_m() < 1.0);
+  CHECK(std::isfinite(st.error_std_m()));
+  // Some PGS edge got ICP errors.
+  std::uint32_t sampled = 0U;
+  const SegmentGraph& g = rig.slam->graph();
+  for (std::uint32_t lv = g.first_live_level(); lv + 1U < g.level_end(); ++lv) {
+    for (std::uint32_t a = 0; a < 5U; ++a) {
+      for (std::uint32_t b = 0; b < 5U; ++b) sampled += g.edge_sample_count(lv, a, b);
+    }
+  }
+  CHECK(sampled > 0U);
+}
+
+TEST(SdpSlam, the_trajectory_follows_the_ground_truth) {
+  const test::ScanSet set(2);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 13));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(rig, set, &sink);
+  // Mean position error against the truth (scan i has stamp i * 0.1 s).
+  double sum = 0.0;
+  for (std::size_t k = 0; k < t.stamps.size(); ++k) {
+    const std::size_t i = static_cast<std::size_t>(t.stamps[k] / 100000);
+    const Pose2 truth = between(set.run.truth[0], set.run.truth[i]);
+    sum += std::hypot(t.poses[k].x_m - truth.x_m, t.poses[k].y_m - truth.y_m);
+  }
+  const double mean = sum / static_cast<double>(t.stamps.size());
+  double odo = 0.0;
+  for (std::size_t i = 0; i < set.run.truth.size(); ++i) {
+    const Pose2 o = between(set.run.odom[0], set.run.odom[i]);
+    const Pose2 g = between(set.run.truth[0], set.run.truth[i]);
+    odo += std::hypot(o.x_m - g.x_m, o.y_m - g.y_m);
+  }
+  odo /= static_cast<double>(set.run.truth.size());
+  CHECK(mean < 0.5 * odo);
+  CHECK(mean < 0.3);
+}
+
+TEST(SdpSlam, same_seed_gives_bit_identical_trajectories) {
+  const test::ScanSet set(2);
+  test::SdpRig a;
+  test::SdpRig b;
+  CHECK_TRUE(a.init(test::sim_options(5), test::small_sdp_options(), 21));
+  CHECK_TRUE(b.init(test::sim_options(5), test::small_sdp_options(), 21));
+  test::CollectPoses sa;
+  test::CollectPoses sb;
+  const Trace ta = run_sdp(a, set, &sa);
+  const Trace tb = run_sdp(b, set, &sb);
+  LONGS_EQUAL(ta.poses.size(), tb.poses.size());
+  CHECK(ta.poses.size() > 100U);
+  CHECK_EQUAL(0, std::memcmp(ta.poses.data(), tb.poses.data(), ta.poses.size() * sizeof(Pose2)));
+  CHECK_TRUE(ta.stamps == tb.stamps);
+  CHECK(a.slam->stats().error_sum_m == b.slam->stats().error_sum_m);
+}
+
+TEST(SdpSlam, tiny_capacities_are_counted_and_survived) {
+  const test::ScanSet set(2);
+  DpSlamOptions b = test::sim_options(3);
+  b.map_observations_base = 2000U;  // the DP map runs out
+  b.map_observations_per_particle = 500U;
+  SdpOptions s = test::small_sdp_options();
+  s.top_particles = 1U;
+  s.max_levels = 2U;
+  s.max_permanent_submaps = 1U;  // the permanent ring forgets
+  s.skeleton_points = 8U;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(b, s, 3));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(rig, set, &sink);
+  const SdpStats& st = rig.slam->stats();
+  CHECK(rig.slam->bottom().stats().map_updates_dropped > 0U);
+  CHECK(st.permanent_forgotten > 0U);
+  CHECK(st.skeleton_truncated_points > 0U || st.skeletons > 0U);
+  CHECK(st.levels_made_permanent > 0U);
+  CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
+  CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+  CHECK_TRUE(rig.slam->graph().invariants_hold());
+  CHECK(t.poses.size() > 100U);
+}
+
+TEST(SdpSlam, segslam_topology_runs_the_same_pipeline) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  s.topology = TopologyMode::kSegSlam;
+  s.segslam_window = 2U;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 4));
+  test::CollectPoses sink;
+  run_sdp(rig, set, &sink);
+  CHECK(rig.slam->stats().segments > 4U);
+  CHECK(rig.slam->stats().evaluations > 0U);
+}
+
+TEST(SdpSlam, dispersion_segmentation_runs_end_to_end) {
+  const test::ScanSet set(1);
+  SdpOptions s = test::small_sdp_options();
+  s.segmentation = SegmentationMode::kDispersion;
+  s.dispersion_threshold_m = 0.02;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 4));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(rig, set, &sink);
+  CHECK(rig.slam->stats().segments > 2U);
+  CHECK(t.poses.size() > 50U);
+}
+
+TEST(SdpSlam, the_best_map_is_made_of_the_global_node_live_submaps_and_the_current_one) {
+  const test::ScanSet set(3);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 11));
+  test::CollectPoses sink;
+  run_sdp(rig, set, &sink);
+  std::uint32_t views = 0U;
+  std::uint32_t known = 0U;
+  rig.slam->for_each_best_submap([&](NodeId node, const Pose2&, const CellRect& r) {
+    ++views;
+    std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
+    std::vector<std::uint8_t> k(v.size());
+    known += rig.slam->bottom().map().fill_rect(node, r, v.data(), k.data());
+  });
+  // global node + 4 live levels + the current segment
+  LONGS_EQUAL(6, views);
+  CHECK(known > 1000U);
+}
