@@ -5,7 +5,9 @@
 #                              paper's world, run SLAM on it, write its map and trajectory
 #                              and print its accuracy
 #   tools/quickstart.sh test   install what is missing, build and run the whole test suite:
-#                              host (debug), ASan+UBSan, aarch64 under qemu, fuzzers
+#                              host (debug; includes the Debian packaging tests, which
+#                              build the amd64 and arm64 package sets), ASan+UBSan,
+#                              aarch64 under qemu, fuzzers
 #
 # Works on a fresh Debian 12 with a compiler and CMake; installs Debian packages as root
 # or through sudo. Environment: SDPSLAM_JOBS (parallel build jobs, default: nproc),
@@ -28,8 +30,13 @@ as_root() {
 # Packages for the host build and tests; cross and fuzz extras for `test`.
 host_pkgs=(cmake ninja-build g++ pkg-config libeigen3-dev libcpputest-dev libpng-dev zlib1g-dev
            libcli11-dev libinih-dev)
-test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils)
+test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils
+           dpkg-dev binutils)
 arm64_pkgs=(libcpputest-dev:arm64)
+# Target libraries of the arm64 package build (tests/packaging). Optional: when the mirror's
+# arm64 indexes lag amd64 this install fails, and the tests unpack the same packages with
+# apt-get download + dpkg -x instead (cmake/fetch-target-sysroot.sh).
+arm64_packaging_pkgs=(libpng-dev:arm64 zlib1g-dev:arm64 libinih-dev:arm64)
 
 missing() {
   local p out=()
@@ -90,6 +97,8 @@ case "$mode" in
       apt_updated=0
     fi
     install "${host_pkgs[@]}" "${test_pkgs[@]}" "${arm64_pkgs[@]}"
+    install "${arm64_packaging_pkgs[@]}" 2>/dev/null \
+      || echo "quickstart: multiarch arm64 libpng/zlib/inih did not install; the packaging tests will unpack them into a sysroot" >&2
     [ -d ../shared ] || echo "quickstart: ../shared is absent: tests that need the benchmark logs and sensor captures will be reported as skipped" >&2
     mkdir -p build
     start=$(date +%s)

@@ -1,0 +1,187 @@
+# Install rules, the exported CMake package and the Debian packages (CPack).
+#
+# Included once from the top-level CMakeLists.txt after every target exists: install()
+# of a target made in another folder is allowed since CMake 3.13, and keeping the rules
+# here gives one place that says what ships.
+#
+# Two components, one Debian package each:
+#   runtime -> `sdpslam`        sdpslamd, its systemd unit, /etc/sdpslam/sdpslamd.ini
+#                               (conffile), sysusers/tmpfiles snippets, the `sdpslam` tools
+#   dev     -> `libsdpslam-dev` headers, static libraries, CMake package (sdpslam::core, ...)
+#
+# Libraries are installed static only. The core is meant to be linked into firmware (one
+# self-contained program per robot computer) and the project makes no ABI promise yet, so
+# a shared library would add a soname policy and nothing else.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(SDPSLAM_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/sdpslam" CACHE STRING
+  "Where the CMake package files go, relative to the prefix")
+
+# ---- libraries, headers, CMake package (component dev) --------------------------------
+# target -> name under sdpslam:: ; only what this build has (drivers and io are optional).
+set(_sdpslam_exports
+  sdpslam_core=core sdpslam_hal=hal
+  sdpslam_drivers_common=drivers_common sdpslam_drivers_can=drivers_can
+  sdpslam_drivers_serial=drivers_serial sdpslam_drivers=drivers
+  sdpslam_io=io)
+set(_sdpslam_export_targets "")
+foreach(pair IN LISTS _sdpslam_exports)
+  string(REPLACE "=" ";" pair "${pair}")
+  list(GET pair 0 target)
+  list(GET pair 1 export_name)
+  if(TARGET ${target})
+    set_target_properties(${target} PROPERTIES EXPORT_NAME ${export_name})
+    list(APPEND _sdpslam_export_targets ${target})
+  endif()
+endforeach()
+set(SDPSLAM_EXPORTS_IO OFF)
+if(TARGET sdpslam_io)
+  set(SDPSLAM_EXPORTS_IO ON)
+endif()
+
+install(TARGETS ${_sdpslam_export_targets} EXPORT sdpslamTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+# Public headers: every include/ folder of an exported library (include/sdpslam/<part>/).
+foreach(target IN LISTS _sdpslam_export_targets)
+  get_target_property(dirs ${target} INTERFACE_INCLUDE_DIRECTORIES)
+  foreach(dir IN LISTS dirs)
+    if(dir MATCHES "^\\$<BUILD_INTERFACE:(.*)>$")
+      install(DIRECTORY "${CMAKE_MATCH_1}/" DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        COMPONENT dev FILES_MATCHING PATTERN "*.h")
+    endif()
+  endforeach()
+endforeach()
+
+install(EXPORT sdpslamTargets NAMESPACE sdpslam:: DESTINATION ${SDPSLAM_INSTALL_CMAKEDIR}
+  COMPONENT dev)
+configure_package_config_file("${CMAKE_CURRENT_LIST_DIR}/sdpslamConfig.cmake.in"
+  "${PROJECT_BINARY_DIR}/sdpslamConfig.cmake" INSTALL_DESTINATION ${SDPSLAM_INSTALL_CMAKEDIR})
+write_basic_package_version_file("${PROJECT_BINARY_DIR}/sdpslamConfigVersion.cmake"
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
+install(FILES "${PROJECT_BINARY_DIR}/sdpslamConfig.cmake" "${PROJECT_BINARY_DIR}/sdpslamConfigVersion.cmake"
+  DESTINATION ${SDPSLAM_INSTALL_CMAKEDIR} COMPONENT dev)
+
+# ---- programs, service, configuration (component runtime) -----------------------------
+# /etc when installing for the system (prefix /usr, as the packages do); under any other
+# prefix the configuration stays inside it so `cmake --install --prefix DIR` never writes
+# outside DIR.
+if(IS_ABSOLUTE "${CMAKE_INSTALL_FULL_SYSCONFDIR}" AND NOT CMAKE_INSTALL_FULL_SYSCONFDIR MATCHES "^${CMAKE_INSTALL_PREFIX}/")
+  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_FULL_SYSCONFDIR}/sdpslam")
+else()
+  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_SYSCONFDIR}/sdpslam")
+endif()
+# systemd's own folders under the prefix (/usr/lib/... on a merged-/usr Debian).
+set(SDPSLAM_INSTALL_SYSTEMDDIR "lib/systemd/system")
+
+if(TARGET sdpslam)
+  install(TARGETS sdpslam RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+endif()
+set(_sdpslam_conffiles "")
+set(_sdpslam_has_daemon OFF)
+if(TARGET sdpslamd)
+  set(_sdpslam_has_daemon ON)
+  set(_fw "${PROJECT_SOURCE_DIR}/firmware-host")
+  install(TARGETS sdpslamd RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+  file(GLOB _units "${_fw}/systemd/*.service" "${_fw}/systemd/*.socket" "${_fw}/systemd/*.timer")
+  if(_units)
+    install(FILES ${_units} DESTINATION ${SDPSLAM_INSTALL_SYSTEMDDIR} COMPONENT runtime)
+  endif()
+  if(EXISTS "${_fw}/sdpslamd.ini")
+    install(FILES "${_fw}/sdpslamd.ini" DESTINATION ${SDPSLAM_INSTALL_CONFDIR} COMPONENT runtime)
+    if(IS_ABSOLUTE "${SDPSLAM_INSTALL_CONFDIR}")
+      list(APPEND _sdpslam_conffiles "${SDPSLAM_INSTALL_CONFDIR}/sdpslamd.ini")
+    else()
+      list(APPEND _sdpslam_conffiles "${CMAKE_INSTALL_PREFIX}/${SDPSLAM_INSTALL_CONFDIR}/sdpslamd.ini")
+    endif()
+  endif()
+  install(FILES "${CMAKE_CURRENT_LIST_DIR}/debian/sdpslam.sysusers"
+    DESTINATION lib/sysusers.d RENAME sdpslam.conf COMPONENT runtime)
+  install(FILES "${CMAKE_CURRENT_LIST_DIR}/debian/sdpslam.tmpfiles"
+    DESTINATION lib/tmpfiles.d RENAME sdpslam.conf COMPONENT runtime)
+endif()
+# The offline runner's documented defaults, as an example for `sdpslam run --config`.
+if(TARGET sdpslam AND EXISTS "${PROJECT_SOURCE_DIR}/tools/slam/default.ini")
+  install(FILES "${PROJECT_SOURCE_DIR}/tools/slam/default.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
+    RENAME sdpslam-run.ini COMPONENT runtime)
+endif()
+
+# ---- Debian packages ------------------------------------------------------------------
+# Debian architecture of the *target* (CPack would ask dpkg, i.e. the build machine).
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  set(SDPSLAM_DEB_ARCH amd64)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64)$")
+  set(SDPSLAM_DEB_ARCH arm64)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^arm")
+  set(SDPSLAM_DEB_ARCH armhf)  # the toolchain is arm-linux-gnueabihf
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^i.86$")
+  set(SDPSLAM_DEB_ARCH i386)
+else()
+  set(SDPSLAM_DEB_ARCH ${CMAKE_SYSTEM_PROCESSOR})
+endif()
+
+set(SDPSLAM_DEB_MAINTAINER "sdpslam maintainers <sdpslam@localhost>" CACHE STRING
+  "Maintainer field of the Debian packages")
+
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME sdpslam)
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_CONTACT "${SDPSLAM_DEB_MAINTAINER}")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Segmented DP-SLAM for wheeled robots in fixed memory")
+set(CPACK_PACKAGING_INSTALL_PREFIX "${CMAKE_INSTALL_PREFIX}")
+set(CPACK_PACKAGE_DIRECTORY "${PROJECT_BINARY_DIR}/packages")
+set(CPACK_STRIP_FILES ON)
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_COMPONENTS_ALL dev)
+if(TARGET sdpslam OR TARGET sdpslamd)
+  list(PREPEND CPACK_COMPONENTS_ALL runtime)
+endif()
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_RELEASE 1)
+set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${SDPSLAM_DEB_ARCH})
+set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
+
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME sdpslam)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION science)
+set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
+  "Segmented DP-SLAM onboard program and tools\n sdpslamd builds a map and the robot's trajectory on the robot's computer from\n wheel encoders (SocketCAN) and a laser rangefinder (serial), in fixed memory.\n The sdpslam command simulates, converts logs, runs SLAM offline and evaluates.\n The systemd unit is installed but not enabled.")
+set(CPACK_DEBIAN_DEV_PACKAGE_NAME libsdpslam-dev)
+set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
+set(CPACK_COMPONENT_DEV_DESCRIPTION
+  "Segmented DP-SLAM library: headers, static libraries, CMake package\n find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal,\n sdpslam::drivers and sdpslam::io.")
+# The CMake package finds these (sdpslamConfig.cmake).
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3)")
+if(SDPSLAM_EXPORTS_IO)
+  string(APPEND CPACK_DEBIAN_DEV_PACKAGE_DEPENDS ", libpng-dev, zlib1g-dev")
+endif()
+
+# Depends of the programs. Natively dpkg-shlibdeps computes them from the binaries. A
+# cross build cannot run it usefully (the target's libraries are not registered with the
+# build machine's dpkg), so the list is stated; the packaging test checks it against the
+# binaries' DT_NEEDED entries and against what dpkg-shlibdeps finds for amd64.
+set(SDPSLAM_DEB_CROSS_DEPENDS
+  "libc6 (>= 2.35), libgcc-s1 (>= 3.0), libinih1 (>= 40), libpng16-16 (>= 1.6.2-1), libstdc++6 (>= 11), zlib1g (>= 1:1.2.6)"
+  CACHE STRING "Depends of the sdpslam package in cross builds (dpkg-shlibdeps is used natively)")
+if(CMAKE_CROSSCOMPILING)
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "${SDPSLAM_DEB_CROSS_DEPENDS}")
+else()
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+endif()
+
+if(_sdpslam_has_daemon)
+  set(_extra "${PROJECT_BINARY_DIR}/debian-runtime")
+  file(MAKE_DIRECTORY "${_extra}")
+  file(COPY "${CMAKE_CURRENT_LIST_DIR}/debian/postinst" "${CMAKE_CURRENT_LIST_DIR}/debian/postrm"
+    DESTINATION "${_extra}")
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA "${_extra}/postinst;${_extra}/postrm")
+  if(_sdpslam_conffiles)
+    list(JOIN _sdpslam_conffiles "\n" _lines)
+    file(WRITE "${_extra}/conffiles" "${_lines}\n")
+    list(APPEND CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA "${_extra}/conffiles")
+  endif()
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+endif()
+
+include(CPack)

@@ -1,0 +1,269 @@
+#!/usr/bin/env bash
+# The packaging tests (tests/packaging/CMakeLists.txt runs each step as one CTest test).
+#
+#   packaging.sh sysroot  ARCH SRC SYSROOT          target libraries for a cross build
+#   packaging.sh build    ARCH SRC DIR [SYSROOT]    configure preset package-ARCH in DIR, build, cpack
+#   packaging.sh contents ARCH DIR                  check the .deb files of DIR/packages
+#   packaging.sh consumer ARCH DIR SRC WORK [SYSROOT]
+#                                                   build tests/packaging/consumer against the
+#                                                   unpacked libsdpslam-dev and run it (under
+#                                                   qemu for a foreign ARCH)
+#   packaging.sh qemu     ARCH DIR AMD64_DIR WORK SYSROOT
+#                                                   run the packaged ARCH programs under qemu-user
+#                                                   and compare with the amd64 package's output
+#
+# Exit status: 0 pass, 1 fail (the message says what), 77 skipped (a prerequisite of the
+# machine is missing: the message says which).
+set -euo pipefail
+
+say() { printf 'packaging: %s\n' "$*"; }
+fail() { printf 'packaging: FAIL: %s\n' "$*" >&2; exit 1; }
+skip() { printf 'packaging: SKIPPED: %s\n' "$*" >&2; exit 77; }
+jobs=${SDPSLAM_PACKAGING_JOBS:-2}
+
+triplet_of() {
+  case "$1" in
+    amd64) echo x86_64-linux-gnu ;;
+    arm64) echo aarch64-linux-gnu ;;
+    armhf) echo arm-linux-gnueabihf ;;
+    *) fail "unknown architecture $1" ;;
+  esac
+}
+qemu_of() {
+  case "$1" in arm64) echo qemu-aarch64 ;; armhf) echo qemu-arm ;; *) echo "" ;; esac
+}
+elf_machine_of() {
+  case "$1" in amd64) echo 'Advanced Micro Devices X86-64' ;; arm64) echo AArch64 ;; armhf) echo ARM ;; esac
+}
+# Command prefix that runs a program of ARCH on this machine (empty when native).
+runner_of() {  # ARCH SYSROOT
+  local q; q=$(qemu_of "$1")
+  [ -z "$q" ] && return 0
+  command -v "$q" >/dev/null || skip "$q is not installed (apt-get install qemu-user)"
+  local t; t=$(triplet_of "$1")
+  echo "$q -L /usr/$t -E LD_LIBRARY_PATH=$2/usr/lib/$t:$2/lib/$t"
+}
+deb_of() {  # DIR PACKAGE ARCH
+  local f
+  f=$(ls "$1"/packages/"$2"_*_"$3".deb 2>/dev/null | head -n1)
+  [ -n "$f" ] || fail "no $2 package for $3 in $1/packages"
+  echo "$f"
+}
+elapsed() { echo $(( $(date +%s) - $1 )); }
+
+cmd=${1:-}
+shift || true
+case "$cmd" in
+sysroot)
+  arch=$1 src=$2 sysroot=$3
+  t=$(triplet_of "$arch")
+  # Plain multiarch first (apt-get install libpng-dev:ARCH ...): then no folder is needed
+  # and cmake/SdpslamTargetSysroot.cmake, finding none, leaves the search paths alone.
+  if [ -e "/usr/lib/$t/libpng16.so" ] && [ -e "/usr/lib/$t/libz.so" ] && [ -e "/usr/lib/$t/libinih.so" ]; then
+    rm -rf "$sysroot"
+    say "the $arch libpng, zlib and inih are installed through multiarch: no sysroot needed"
+    exit 0
+  fi
+  "$src/cmake/fetch-target-sysroot.sh" "$arch" "$sysroot" \
+    || skip "cannot get the $arch libpng/zlib/inih: not installed through multiarch, and apt-get download failed"
+  ;;
+
+build)
+  arch=$1 src=$2 dir=$3 sysroot=${4:-}
+  start=$(date +%s)
+  args=(-S "$src" --preset "package-$arch" -B "$dir")
+  [ -n "$sysroot" ] && args+=("-DSDPSLAM_TARGET_SYSROOT=$sysroot")
+  cmake "${args[@]}" >"$dir.configure.log" 2>&1 || { cat "$dir.configure.log"; fail "configure package-$arch"; }
+  cmake --build "$dir" -j "$jobs" || fail "build package-$arch"
+  rm -rf "$dir/packages"
+  (cd "$dir" && cpack --config CPackConfig.cmake) || fail "cpack package-$arch"
+  say "package-$arch built in $(elapsed "$start") s:"
+  for f in "$dir"/packages/*.deb; do
+    printf '  %-40s %8d bytes  %3d files\n' "$(basename "$f")" "$(stat -c %s "$f")" \
+      "$(dpkg-deb -c "$f" | grep -vc '/$')"
+  done
+  ;;
+
+contents)
+  arch=$1 dir=$2
+  t=$(triplet_of "$arch")
+  rt=$(deb_of "$dir" sdpslam "$arch")
+  dev=$(deb_of "$dir" libsdpslam-dev "$arch")
+  errors=0
+  bad() { printf 'packaging: FAIL: %s\n' "$*" >&2; errors=$((errors + 1)); }
+  has() {  # DEB PATH
+    dpkg-deb -c "$1" | awk '{print $6}' | grep -qx "./${2#/}" || bad "$(basename "$1") lacks /${2#/}"
+  }
+  for deb in "$rt" "$dev"; do
+    a=$(dpkg-deb -f "$deb" Architecture)
+    [ "$a" = "$arch" ] || bad "$(basename "$deb"): Architecture is '$a', not $arch"
+    # Everything under /usr or /etc; no trace of the build machine.
+    stray=$(dpkg-deb -c "$deb" | awk '{print $6}' | grep -Ev '^\./(usr|etc)(/|$)|^\./$' || true)
+    [ -z "$stray" ] && true || bad "$(basename "$deb") has files outside /usr and /etc: $stray"
+    owners=$(dpkg-deb -c "$deb" | awk '{print $2}' | sort -u | tr '\n' ' ')
+    [ "$owners" = "root/root " ] || bad "$(basename "$deb"): owners are $owners, not root/root"
+  done
+
+  # Runtime package: programs for the right machine, and what the daemon needs.
+  has "$rt" usr/bin/sdpslam
+  daemon=0
+  [ -e "$dir/firmware-host/sdpslamd" ] && daemon=1
+  if [ $daemon = 1 ]; then
+    has "$rt" usr/bin/sdpslamd
+    has "$rt" etc/sdpslam/sdpslamd.ini
+    has "$rt" usr/lib/sysusers.d/sdpslam.conf
+    has "$rt" usr/lib/tmpfiles.d/sdpslam.conf
+    srcdir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$dir/CMakeCache.txt")
+    for unit in "$srcdir"/firmware-host/systemd/*.service; do
+      [ -e "$unit" ] || { say "no systemd unit in firmware-host/systemd yet: not checked"; break; }
+      has "$rt" "usr/lib/systemd/system/$(basename "$unit")"
+    done
+    dpkg-deb -I "$rt" conffiles 2>/dev/null | grep -qx /etc/sdpslam/sdpslamd.ini \
+      || bad "/etc/sdpslam/sdpslamd.ini is not a conffile"
+    dpkg-deb -I "$rt" postinst 2>/dev/null | grep -q systemd-sysusers || bad "postinst does not create the user"
+    dpkg-deb -I "$rt" postinst 2>/dev/null | grep -Eq '^[^#]*systemctl[^#]*(enable|start)' \
+      && bad "postinst enables or starts the service (left to the administrator)"
+  else
+    say "sdpslamd is not part of this tree yet: daemon files not checked"
+  fi
+  stage=$(mktemp -d)
+  trap 'rm -rf "$stage"' EXIT
+  dpkg -x "$rt" "$stage/rt"
+  dpkg -x "$dev" "$stage/dev"
+  machine=$(elf_machine_of "$arch")
+  depends=$(dpkg-deb -f "$rt" Depends)
+  say "sdpslam Depends: $depends"
+  for bin in "$stage"/rt/usr/bin/*; do
+    readelf -h "$bin" | grep -q "Machine:.*$machine" || bad "$(basename "$bin") is not a $arch ($machine) program"
+    # Every shared library the program needs must come from a package in Depends.
+    for so in $(readelf -d "$bin" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'); do
+      case "$so" in
+        libc.so.*|libm.so.*|libutil.so.*|libpthread.so.*|libdl.so.*|librt.so.*|ld-linux*) pkg=libc6 ;;
+        libstdc++.so.*) pkg=libstdc++6 ;;
+        libgcc_s.so.*) pkg=libgcc-s1 ;;
+        libpng16.so.*) pkg=libpng16-16 ;;
+        libz.so.*) pkg=zlib1g ;;
+        libinih.so.*) pkg=libinih1 ;;
+        *) bad "$(basename "$bin") needs $so, which this test cannot map to a package"; continue ;;
+      esac
+      printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/ .*//' | grep -qx "$pkg" \
+        || bad "$(basename "$bin") needs $so but Depends lacks $pkg"
+    done
+  done
+  # The libc6 version in Depends covers the newest glibc symbol version used.
+  libc_min=$(printf '%s\n' "$depends" | tr ',' '\n' | sed -n 's/^ *libc6 (>= \([0-9.]*\)).*/\1/p')
+  glibc_max=$(for bin in "$stage"/rt/usr/bin/*; do readelf -V "$bin"; done | grep -o 'GLIBC_[0-9.]*' | sed 's/GLIBC_//' | sort -V | tail -n1)
+  [ -n "$libc_min" ] || bad "Depends has no versioned libc6"
+  if [ -n "$glibc_max" ] && [ -n "$libc_min" ] && [ "$(printf '%s\n%s\n' "$glibc_max" "$libc_min" | sort -V | tail -n1)" != "$libc_min" ]; then
+    bad "the programs use GLIBC_$glibc_max symbols but Depends asks only libc6 (>= $libc_min)"
+  fi
+  say "newest glibc symbol version used: ${glibc_max:-none}; Depends: libc6 (>= $libc_min)"
+  if [ "$arch" = amd64 ]; then
+    # The list stated for cross builds names the same packages dpkg-shlibdeps finds here.
+    stated=$(sed -n 's/^SDPSLAM_DEB_CROSS_DEPENDS:STRING=//p' "$dir/CMakeCache.txt" | tr ',' '\n' | sed 's/^ *//; s/ .*//' | sort | tr '\n' ' ')
+    found=$(printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/ .*//' | sort -u | tr '\n' ' ')
+    [ "$stated" = "$found" ] || bad "cross Depends names '$stated' but dpkg-shlibdeps finds '$found'"
+  fi
+
+  # Development package: headers, static libraries, CMake package.
+  for h in core/arena.h core/pool.h core/pose2.h core/dpslam_filter.h hal/clock.h \
+           drivers/linux_clock.h drivers/scip2.h drivers/socketcan_bus.h io/log_reader.h io/trajectory_io.h; do
+    has "$dev" "usr/include/sdpslam/$h"
+  done
+  for l in core drivers_common drivers_can drivers_serial io; do
+    has "$dev" "usr/lib/$t/libsdpslam_$l.a"
+    if [ -f "$stage/dev/usr/lib/$t/libsdpslam_$l.a" ]; then
+      obj=$(cd "$stage" && ar x --output="$stage" "dev/usr/lib/$t/libsdpslam_$l.a" && ls "$stage"/*.o | head -n1)
+      readelf -h "$obj" | grep -q "Machine:.*$machine" || bad "libsdpslam_$l.a is not $arch code"
+      rm -f "$stage"/*.o
+    fi
+  done
+  for c in sdpslamConfig.cmake sdpslamConfigVersion.cmake sdpslamTargets.cmake sdpslamTargets-release.cmake; do
+    has "$dev" "usr/lib/$t/cmake/sdpslam/$c"
+  done
+  srcdir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$dir/CMakeCache.txt")
+  grep -qF -e "$srcdir" -e "$dir" "$stage"/dev/usr/lib/"$t"/cmake/sdpslam/*.cmake \
+    && bad "the CMake package names a path of the build machine"
+  dpkg-deb -f "$dev" Depends | grep -q libeigen3-dev || bad "libsdpslam-dev does not depend on libeigen3-dev"
+  [ -z "$(find "$stage/dev" -name '*.so*')" ] || bad "libsdpslam-dev ships a shared library"
+
+  for deb in "$rt" "$dev"; do
+    say "$(basename "$deb"): $(stat -c %s "$deb") bytes, installed size $(dpkg-deb -f "$deb" Installed-Size) KiB"
+    dpkg-deb -c "$deb" | awk '$6 !~ /\/$/ {printf "    %8d %s\n", $3, $6}'
+  done
+  [ $errors = 0 ] || fail "$errors problem(s) in the $arch packages"
+  say "$arch packages: contents, architecture and Depends as expected"
+  ;;
+
+consumer)
+  arch=$1 dir=$2 src=$3 work=$4 sysroot=${5:-}
+  t=$(triplet_of "$arch")
+  dev=$(deb_of "$dir" libsdpslam-dev "$arch")
+  rm -rf "$work"
+  mkdir -p "$work/scratch"
+  dpkg -x "$dev" "$work/stage"
+  version=$(dpkg-deb -f "$dev" Version)
+  version=${version%%-*}
+  major=${version%%.*}
+  args=(-S "$src/tests/packaging/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release
+        "-DCMAKE_PREFIX_PATH=$work/stage/usr")
+  if [ "$arch" != amd64 ]; then
+    toolchain=$src/toolchains/$t.cmake
+    # The installed package and the target's libpng/zlib are both "target" roots.
+    args+=("-DCMAKE_TOOLCHAIN_FILE=$toolchain" "-DCMAKE_FIND_ROOT_PATH=$work/stage;$sysroot"
+           "-DCMAKE_EXE_LINKER_FLAGS=-Wl,-rpath-link,$sysroot/usr/lib/$t:$sysroot/lib/$t")
+  fi
+  # SameMajorVersion: the next major must be refused, this one accepted.
+  if cmake "${args[@]}" -B "$work/wrong-major" "-DSDPSLAM_WANT_VERSION=$((major + 1)).0" >"$work/wrong-major.log" 2>&1; then
+    fail "find_package(sdpslam $((major + 1)).0) accepted version $version"
+  fi
+  grep -q 'compatible with requested version' "$work/wrong-major.log" || { cat "$work/wrong-major.log"; fail "refused for another reason than the version"; }
+  say "find_package(sdpslam $((major + 1)).0) refused version $version, as it should"
+  cmake "${args[@]}" -B "$work/build" "-DSDPSLAM_WANT_VERSION=$major.0" >"$work/configure.log" 2>&1 \
+    || { cat "$work/configure.log"; fail "consumer configure against the installed package"; }
+  grep 'sdpslam .* from' "$work/configure.log" | sed 's/^-- /packaging: /'
+  cmake --build "$work/build" -j "$jobs" || fail "consumer build"
+  runner=$(runner_of "$arch" "$sysroot")
+  # shellcheck disable=SC2086
+  $runner "$work/build/consumer" "$work/scratch" || fail "consumer run"
+  ;;
+
+qemu)
+  arch=$1 dir=$2 native_dir=$3 work=$4 sysroot=$5
+  runner=$(runner_of "$arch" "$sysroot")
+  rm -rf "$work"
+  mkdir -p "$work"
+  dpkg -x "$(deb_of "$dir" sdpslam "$arch")" "$work/$arch"
+  dpkg -x "$(deb_of "$native_dir" sdpslam amd64)" "$work/amd64"
+  # A short job of the packaged tool on both architectures; the outputs must match byte
+  # for byte (determinism across platforms is a project rule).
+  sim=(simulate --max-duration 20)
+  start=$(date +%s)
+  "$work/amd64/usr/bin/sdpslam" "${sim[@]}" --out "$work/out-amd64" >"$work/amd64.log" 2>&1 \
+    || { cat "$work/amd64.log"; fail "amd64 sdpslam simulate"; }
+  native_s=$(elapsed "$start")
+  start=$(date +%s)
+  # shellcheck disable=SC2086
+  $runner "$work/$arch/usr/bin/sdpslam" "${sim[@]}" --out "$work/out-$arch" >"$work/$arch.log" 2>&1 \
+    || { cat "$work/$arch.log"; fail "$arch sdpslam simulate under $(qemu_of "$arch")"; }
+  say "sdpslam ${sim[*]}: amd64 ${native_s} s, $arch under $(qemu_of "$arch") $(elapsed "$start") s"
+  differ=()
+  for f in "$work/out-amd64"/*; do
+    name=$(basename "$f")
+    if cmp -s "$f" "$work/out-$arch/$name"; then
+      say "  identical: $name ($(stat -c %s "$f") bytes, sha256 $(sha256sum "$f" | cut -c1-16))"
+    else
+      say "  DIFFERENT: $name: $(cmp "$f" "$work/out-$arch/$name" 2>&1 | head -n1)"
+      differ+=("$name")
+    fi
+  done
+  diff <(cd "$work/out-amd64" && ls) <(cd "$work/out-$arch" && ls) >/dev/null || fail "different sets of output files"
+  [ ${#differ[@]} = 0 ] || fail "$arch output differs from amd64 in: ${differ[*]}"
+  say "$arch and amd64 outputs are bit-identical"
+  ;;
+
+*)
+  sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'
+  exit 2
+  ;;
+esac
