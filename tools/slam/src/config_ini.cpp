@@ -110,42 +110,50 @@ bool set_option(DpSlamOptions& o, const std::string& section, const std::string&
 int handler(void* user, const char* section, const char* name, const char* value) {
   auto* st = static_cast<ParseState*>(user);
   const int lineno = st->line;
-  const std::string sec(section);
-  const std::string key(name != nullptr ? name : "");
   if (name == nullptr) return 1;  // section header alone
   std::string why;
-  bool ok;
-  if (sec == "log") {
-    if (key == "default_range_max_m") {
-      double r = 0.0;
-      ok = parse_real(value, &r) && r > 0.0 && r <= 1000.0;
-      if (ok) st->config->log.default_range_max_m = static_cast<float>(r);
-      else why = "log.default_range_max_m: '" + std::string(value) + "' out of range (0, 1000]";
-    } else {
-      ok = false;
-      why = "unknown key '" + key + "' in section [log]";
-    }
-  } else {
-    DpSlamOptions trial = st->config->filter;
-    ok = set_option(trial, sec, key, value, &why);
-    if (ok) {
-      char reason[200];
-      if (!trial.validate(reason, sizeof reason)) {
-        ok = false;
-        why = reason;
-      } else {
-        st->config->filter = trial;
-      }
-    }
-  }
-  if (!ok) {
-    if (st->error.empty()) st->error = st->file + ":" + std::to_string(lineno) + ": " + why;
-    return 0;
-  }
-  return 1;
+  const ConfigKeyResult r = apply_config_key(st->config, section, name, value, &why);
+  if (r == ConfigKeyResult::kApplied) return 1;
+  if (r == ConfigKeyResult::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + section + "]";
+  if (st->error.empty()) st->error = st->file + ":" + std::to_string(lineno) + ": " + why;
+  return 0;
 }
 
 }  // namespace
+
+bool is_slam_config_section(const std::string& section) {
+  return section == "filter" || section == "motion" || section == "observation" || section == "map" ||
+         section == "capacity" || section == "log";
+}
+
+ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, const std::string& key,
+                                 const char* value, std::string* why) {
+  if (!is_slam_config_section(sec)) return ConfigKeyResult::kUnknown;
+  if (sec == "log") {
+    if (key != "default_range_max_m") return ConfigKeyResult::kUnknown;
+    double r = 0.0;
+    if (parse_real(value, &r) && r > 0.0 && r <= 1000.0) {
+      config->log.default_range_max_m = static_cast<float>(r);
+      return ConfigKeyResult::kApplied;
+    }
+    *why = "log.default_range_max_m: '" + std::string(value) + "' out of range (0, 1000]";
+    return ConfigKeyResult::kInvalid;
+  }
+  DpSlamOptions trial = config->filter;
+  std::string reason_text;
+  if (!set_option(trial, sec, key, value, &reason_text)) {
+    if (reason_text.rfind("unknown key", 0) == 0) return ConfigKeyResult::kUnknown;
+    *why = reason_text;
+    return ConfigKeyResult::kInvalid;
+  }
+  char reason[200];
+  if (!trial.validate(reason, sizeof reason)) {
+    *why = reason;
+    return ConfigKeyResult::kInvalid;
+  }
+  config->filter = trial;
+  return ConfigKeyResult::kApplied;
+}
 
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
   std::FILE* f = std::fopen(path.c_str(), "r");

@@ -13,16 +13,10 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
+#include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::slam {
 namespace {
-
-struct ScanLog {
-  std::int64_t stamp_us;
-  Pose2 odom;
-  Pose2 online;
-  bool processed;
-};
 
 class CollectSink final : public PoseSink {
  public:
@@ -69,7 +63,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   CollectSink sink;
   filter->set_pose_sink(&sink);
 
-  std::vector<ScanLog> scans;
+  std::vector<ScanRecord> scans;
   std::vector<double> scan_ms;
   std::vector<double> processed_ms;
   Pose2 last_odom;
@@ -101,7 +95,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     const bool processed = r.status == StepResult::Status::kProcessed;
     scan_ms.push_back(ms);
     if (processed) processed_ms.push_back(ms);
-    scans.push_back(ScanLog{rec.stamp_us, od.pose, r.pose, processed});
+    scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, processed});
     if (options.progress && scans.size() % 200U == 0U) {
       std::fprintf(stderr, "\rscans %zu processed %llu", scans.size(),
                    static_cast<unsigned long long>(filter->stats().processed));
@@ -116,62 +110,14 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   // The final best particle's path: committed poses, then its own uncommitted ones.
   std::vector<io::StampedPose> path = sink.poses;
   filter->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
-  // One pose per scan: the path where it has the scan, else the last anchored pose
-  // composed with the odometry since (skipped scans, or gaps left by path exhaustion).
-  std::vector<io::StampedPose> trajectory;
-  trajectory.reserve(scans.size());
-  std::size_t pi = 0U;
-  bool anchored = false;
-  Pose2 anchor_pose;
-  Pose2 anchor_odom;
   std::uint64_t path_gaps = 0U;
-  for (const ScanLog& s : scans) {
-    Pose2 pose;
-    bool from_path = false;
-    if (s.processed) {
-      while (pi < path.size() && path[pi].stamp_us < s.stamp_us) ++pi;
-      if (pi < path.size() && path[pi].stamp_us == s.stamp_us) {
-        pose = path[pi].pose;
-        ++pi;
-        from_path = true;
-      } else {
-        ++path_gaps;
-      }
-    }
-    if (!from_path) pose = anchored ? anchor_pose.compose(between(anchor_odom, s.odom)) : s.online;
-    if (from_path || !anchored) {
-      anchor_pose = pose;
-      anchor_odom = s.odom;
-      anchored = true;
-    }
-    trajectory.push_back({s.stamp_us, pose});
-  }
+  const std::vector<io::StampedPose> trajectory = assemble_trajectory(scans, path, &path_gaps);
 
   // The best particle's map.
   const DpMap& map = filter->map();
   io::OccupancyImage image;
-  image.resolution_m = map.resolution_m();
-  CellRect rect;
-  std::uint32_t known_cells = 0U;
-  if (map.touched_bounds(&rect)) {
-    std::vector<CellObservation> values(static_cast<std::size_t>(rect.width) * rect.height);
-    std::vector<std::uint8_t> known(values.size(), 0U);
-    known_cells = map.fill_rect(filter->best_node(), rect, values.data(), known.data());
-    image.width = rect.width;
-    image.height = rect.height;
-    image.origin_x_m = map.options().origin_x_m + rect.ix0 * map.resolution_m();
-    image.origin_y_m = map.options().origin_y_m + rect.iy0 * map.resolution_m();
-    image.occupancy.resize(values.size());
-    for (std::size_t i = 0; i < values.size(); ++i) {
-      image.occupancy[i] = known[i] != 0U ? static_cast<float>(filter->occupancy(values[i])) : -1.0F;
-    }
-  }
-
-  if (!io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error)) return RunStatus::kIoError;
-  if (image.width > 0U) {
-    if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return RunStatus::kIoError;
-    if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return RunStatus::kIoError;
-  }
+  const std::uint32_t known_cells = best_map_image(*filter, &image);
+  if (!write_trajectory_and_map(out_dir, trajectory, image, error)) return RunStatus::kIoError;
 
   // stats.json: deterministic fields first, timing apart.
   const AncestryTree& tree = filter->tree();

@@ -20,4 +20,15 @@ struct SlamConfig {
 // `error` is then "file:line: reason".
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
 
+// One `key = value` of the sections above ([filter] [motion] [observation] [map]
+// [capacity] [log]), for programs whose own INI files embed these sections (sdpslamd).
+// kApplied: *config changed and is still valid; kUnknown: not a key of these sections
+// (*config untouched); kInvalid: a key of these sections whose value is malformed or makes
+// the options invalid (*config untouched, *why says why, without file:line).
+enum class ConfigKeyResult { kApplied, kUnknown, kInvalid };
+ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& section, const std::string& key,
+                                 const char* value, std::string* why);
+// True iff `section` is one of the sections above.
+bool is_slam_config_section(const std::string& section);
+
 }  // namespace sdpslam::slam

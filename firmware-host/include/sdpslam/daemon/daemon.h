@@ -1,0 +1,147 @@
+#pragma once
+// The onboard loop of sdpslamd: one thread, one monotonic clock.
+//
+// Each step():
+//   1. drains the CAN bus through the wheel encoders and the diff-drive odometry
+//      (drivers::EncoderOdometrySource) and appends every new valid pose to the
+//      OdometryRing; a stale encoder marks a break (no motion is ever invented across it);
+//   2. waits for the laser at most loop_slice_us (less while a scan waits for odometry);
+//      a finished scan enters a small queue (full: the oldest is dropped and counted);
+//   3. places queued scans in order: the odometry pose at the scan's stamp is
+//      interpolated (OdometryRing). A scan newer than the newest odometry waits up to
+//      odometry_wait_us for the encoders to catch up, then is skipped and counted; one
+//      older than the ring, or whose bracketing samples straddle a break or a gap longer
+//      than max_interpolation_gap_us, is skipped and counted;
+//   4. feeds placed scans to the SlamEngine and records the latency: pose available minus
+//      the scan's stamp (for SCIP the sensor's stamp mapped onto our clock, ≈ its last
+//      byte's arrival on an idle line) and minus the moment the driver returned it;
+//   5. watches the sensors' counters and states and logs every change (EventLog);
+//   6. every output_period_us writes trajectory.txt, map.pgm/.yaml/.png and status.json
+//      into the output directory, each atomically (a failed write keeps the previous file
+//      and is logged and counted; the next period tries again).
+// run() steps until *stop becomes non-zero (SIGINT/SIGTERM), places what can still be
+// placed, and writes the final outputs.
+//
+// Faults are handled by the drivers (serial re-open + sensor restart, SocketCAN re-open);
+// the loop never exits on a sensor fault. Memory: the object holds the scan queue and the
+// latency windows (~100 KiB): allocate it once at start-up.
+#include <csignal>
+#include <cstdint>
+#include <string>
+
+#include "sdpslam/core/ring_buffer.h"
+#include "sdpslam/daemon/daemon_config.h"
+#include "sdpslam/daemon/event_log.h"
+#include "sdpslam/daemon/odometry_ring.h"
+#include "sdpslam/daemon/slam_engine.h"
+#include "sdpslam/drivers/diff_drive_odometry.h"
+#include "sdpslam/hal/byte_stream.h"
+#include "sdpslam/hal/can_bus.h"
+#include "sdpslam/hal/clock.h"
+#include "sdpslam/hal/range_scan_source.h"
+#include "sdpslam/hal/wheel_encoder_source.h"
+
+namespace sdpslam::daemon {
+
+struct DaemonCounters {
+  std::uint64_t loop_steps = 0U;
+  std::uint64_t scans_received = 0U;
+  std::uint64_t scans_placed = 0U;           // given an odometry pose and fed to the engine
+  std::uint64_t scans_processed = 0U;        // of those, the engine updated its particles
+  std::uint64_t scans_skipped_no_odometry = 0U;  // odometry did not catch up in time
+  std::uint64_t scans_skipped_too_old = 0U;  // older than the odometry ring
+  std::uint64_t scans_skipped_gap = 0U;      // across a stale-encoder break or a long gap
+  std::uint64_t scans_dropped_queue_full = 0U;
+  std::uint64_t odometry_samples = 0U;
+  std::uint64_t odometry_stale_events = 0U;
+  std::uint64_t output_writes = 0U;
+  std::uint64_t output_failures = 0U;
+  std::int64_t max_output_write_us = 0;
+  std::int64_t max_odometry_wait_us = 0;     // longest a placed scan waited for odometry
+  std::uint64_t scans_dropped() const {
+    return scans_skipped_no_odometry + scans_skipped_too_old + scans_skipped_gap + scans_dropped_queue_full;
+  }
+};
+
+// Latency percentiles over the last kWindow placed scans (exact, by sorting a copy).
+struct LatencyFigures {
+  std::uint64_t count = 0U;  // placed scans measured in all
+  double p50_ms = 0.0, p99_ms = 0.0, max_ms = 0.0;  // p50/p99 of the window, max of all
+};
+
+struct DaemonIo {
+  const hal::MonotonicClock* clock = nullptr;
+  hal::CanBus* bus = nullptr;                    // state/stats watched; may be null
+  hal::WheelEncoderSource* encoders = nullptr;
+  // Called until it returns 1 (CANopen NMT start); may be empty.
+  int (*start_encoders)(void* ctx) = nullptr;
+  void* start_ctx = nullptr;
+  hal::RangeScanSource* laser = nullptr;
+  const hal::ByteStream* laser_stream = nullptr;  // stats only; may be null
+  SlamEngine* engine = nullptr;
+};
+
+class Daemon {
+ public:
+  static constexpr std::size_t kLatencyWindow = 4096U;
+
+  Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log);
+  // Creates the output directory. False (with *error) iff that fails.
+  bool start(std::string* error);
+  void step();
+  // Steps until *stop != 0, then finishes (see header). Returns true iff the final
+  // outputs were written.
+  bool run(const volatile std::sig_atomic_t* stop);
+  // Places every queued scan that can be placed now (no waiting), then writes the outputs.
+  bool finish();
+  // Writes trajectory, map (if enabled) and status now. True iff all writes succeeded.
+  bool write_outputs();
+
+  const DaemonCounters& counters() const { return counters_; }
+  LatencyFigures latency_from_stamp() const { return figures(stamp_latency_, stamp_latency_max_us_, latency_count_); }
+  LatencyFigures latency_from_read() const { return figures(read_latency_, read_latency_max_us_, latency_count_); }
+  const OdometryRing& odometry_ring() const { return ring_; }
+  const hal::OdometryReading odometry() const { return odom_.latest(); }
+  std::string status_json() const;
+  std::size_t queued_scans() const { return queue_.size(); }
+
+ private:
+  struct PendingScan {
+    RangeScan scan;
+    std::int64_t read_us = 0;  // when the driver handed it out
+  };
+  void update_odometry();
+  void enqueue(std::int64_t now_us);
+  void place_scans(std::int64_t now_us, bool final_pass);
+  void watch_faults();
+  static LatencyFigures figures(const RingBuffer<std::int32_t, kLatencyWindow>& w, std::int64_t max_us,
+                                std::uint64_t count);
+
+  DaemonConfig config_;
+  DaemonIo io_;
+  EventLog& log_;
+  drivers::EncoderOdometrySource odom_;
+  OdometryRing ring_;
+  RingBuffer<PendingScan, DaemonConfig::kMaxScanQueue> queue_;
+  RangeScan scratch_;
+  PendingScan pending_scratch_;
+  DaemonCounters counters_;
+  RingBuffer<std::int32_t, kLatencyWindow> stamp_latency_;
+  RingBuffer<std::int32_t, kLatencyWindow> read_latency_;
+  std::int64_t stamp_latency_max_us_ = 0;
+  std::int64_t read_latency_max_us_ = 0;
+  std::uint64_t latency_count_ = 0U;
+  bool encoders_started_ = false;
+  std::int64_t start_us_ = 0;
+  std::int64_t next_output_us_ = 0;
+  std::string last_output_error_;
+  // Previous values of watched counters/states.
+  hal::RangeSourceHealth seen_health_ = hal::RangeSourceHealth::kStarting;
+  hal::RangeSourceStats seen_laser_{};
+  hal::CanBusState seen_can_state_ = hal::CanBusState::kActive;
+  hal::CanBusStats seen_can_{};
+  hal::OdometryStatus seen_odom_ = hal::OdometryStatus::kNoData;
+  std::int64_t last_odom_stamp_us_ = 0;
+};
+
+}  // namespace sdpslam::daemon

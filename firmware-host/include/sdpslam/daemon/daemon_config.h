@@ -1,0 +1,75 @@
+#pragma once
+// sdpslamd's configuration: one INI file (libinih), every key documented in
+// firmware-host/sdpslamd.ini. Sections:
+//   [can]     interface, encoder protocol (canopen | odrive), node ids, SYNC period,
+//             position / heartbeat timeouts, re-open interval
+//   [laser]   serial device, protocol (scip | sick), line speed, timeouts, mounting pose
+//   [robot]   differential-drive geometry (drivers::DiffDriveParams)
+//   [sync]    odometry-to-scan alignment: wait bound, largest gap interpolated, queue
+//   [slam]    mode (dpslam | sdp) and seed; the filter's own sections [filter] [motion]
+//             [observation] [map] [capacity] [log] are the offline runner's
+//             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
+//   [output]  directory, write period, trajectory capacity
+//   [daemon]  event-log rate limit, loop slice
+// Unknown sections and keys, malformed and out-of-range values are rejected as
+// "file:line: reason"; keys left out keep their defaults.
+#include <cstdint>
+#include <string>
+
+#include "sdpslam/core/pose2.h"
+#include "sdpslam/drivers/can_wheel_encoders.h"
+#include "sdpslam/drivers/diff_drive_odometry.h"
+#include "sdpslam/drivers/sick_lms2xx_laser.h"
+#include "sdpslam/drivers/urg_scip2_laser.h"
+#include "sdpslam/slam/config_ini.h"
+
+namespace sdpslam::daemon {
+
+enum class LaserProtocol : std::uint8_t { kScip, kSick };
+enum class SlamMode : std::uint8_t { kDpSlam, kSdp };
+const char* to_string(LaserProtocol p);
+const char* to_string(SlamMode m);
+
+struct DaemonConfig {
+  // [can]
+  std::string can_interface = "can0";
+  drivers::CanWheelEncoderConfig encoders;
+  std::int64_t can_reopen_interval_us = 500000;
+  // [laser]
+  std::string laser_device = "/dev/ttyACM0";
+  LaserProtocol laser_protocol = LaserProtocol::kScip;
+  std::uint32_t laser_baud = 115200U;
+  std::int64_t laser_reopen_interval_us = 500000;
+  drivers::UrgOptions urg;
+  drivers::SickOptions sick;
+  Pose2 laser_in_base;
+  // [robot]
+  drivers::DiffDriveParams drive;
+  // [sync]
+  std::int64_t odometry_wait_us = 200000;    // a scan waits this long for newer odometry
+  std::int64_t max_interpolation_gap_us = 250000;
+  std::uint32_t scan_queue = 4U;             // scans waiting for odometry, 1 .. kMaxScanQueue
+  // [slam]
+  SlamMode mode = SlamMode::kDpSlam;
+  std::uint64_t seed = 1U;
+  slam::SlamConfig slam;
+  // [output]
+  std::string output_directory = "/var/lib/sdpslamd";
+  std::int64_t output_period_us = 5000000;
+  std::uint32_t max_trajectory_scans = 200000U;
+  bool write_map = true;
+  // [daemon]
+  std::int64_t log_interval_us = 1000000;    // one line per event kind at most this often
+  std::int64_t loop_slice_us = 5000;         // longest wait on the laser before CAN is read
+
+  static constexpr std::uint32_t kMaxScanQueue = 16U;
+};
+
+// Applies the keys of `path` on top of *config. False iff the file cannot be read, a line
+// is malformed, a section or key is unknown, or a value is malformed or out of range;
+// `error` is then "file:line: reason" (the first problem; *config is then unspecified).
+// Checks that involve several keys (SICK variant, drive geometry, filter options) run
+// once the file is read and name the file and the section.
+bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error);
+
+}  // namespace sdpslam::daemon

@@ -1,0 +1,325 @@
+#include "sdpslam/daemon/daemon.h"
+
+#include <sys/resource.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cstdio>
+
+#include "sdpslam/io/atomic_file.h"
+#include "sdpslam/slam/slam_outputs.h"
+
+namespace sdpslam::daemon {
+namespace {
+
+void sleep_us(std::int64_t us) {
+  if (us <= 0) return;
+  timespec ts{static_cast<time_t>(us / 1000000), static_cast<long>((us % 1000000) * 1000)};
+  nanosleep(&ts, nullptr);
+}
+
+const char* health_name(hal::RangeSourceHealth h) {
+  switch (h) {
+    case hal::RangeSourceHealth::kStarting: return "starting";
+    case hal::RangeSourceHealth::kStreaming: return "streaming";
+    case hal::RangeSourceHealth::kStalled: return "stalled";
+    case hal::RangeSourceHealth::kDisconnected: return "disconnected";
+  }
+  return "?";
+}
+
+std::string fmt_ms(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", v);
+  return b;
+}
+
+}  // namespace
+
+Daemon::Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log)
+    : config_(config), io_(io), log_(log), odom_(*io.encoders, config.drive) {}
+
+bool Daemon::start(std::string* error) {
+  if (!io::make_directories(config_.output_directory, error)) return false;
+  start_us_ = io_.clock->now_us();
+  next_output_us_ = start_us_ + config_.output_period_us;
+  log_.log(Event::kStartup, "mode %s, laser %s on %s, encoders %s, outputs every %.1f s in %s", io_.engine->name(),
+           to_string(config_.laser_protocol), config_.laser_device.c_str(),
+           drivers::to_string(config_.encoders.protocol), static_cast<double>(config_.output_period_us) * 1e-6,
+           config_.output_directory.c_str());
+  return true;
+}
+
+void Daemon::update_odometry() {
+  if (!encoders_started_) {
+    encoders_started_ = io_.start_encoders == nullptr || io_.start_encoders(io_.start_ctx) == 1;
+  }
+  odom_.update();
+  const hal::OdometryReading r = odom_.latest();
+  if (r.status == hal::OdometryStatus::kValid && r.stamp_us > last_odom_stamp_us_) {
+    if (ring_.push(r.stamp_us, r.pose)) ++counters_.odometry_samples;
+    last_odom_stamp_us_ = r.stamp_us;
+  } else if (r.status == hal::OdometryStatus::kLatching && r.stamp_us > last_odom_stamp_us_) {
+    // First pair (or first after an outage): the pose is known at this stamp, and it
+    // starts a new segment (motion since the last valid sample is unknown).
+    ring_.mark_break();
+    if (ring_.push(r.stamp_us, r.pose)) ++counters_.odometry_samples;
+    last_odom_stamp_us_ = r.stamp_us;
+  }
+  if (r.status != seen_odom_) {
+    if (r.status == hal::OdometryStatus::kStale) {
+      ++counters_.odometry_stale_events;
+      ring_.mark_break();
+      log_.log(Event::kOdometry, "encoders stale since %.3f s: scans wait, then are skipped; no motion is invented",
+               static_cast<double>(r.stamp_us - start_us_) * 1e-6);
+    } else if (seen_odom_ == hal::OdometryStatus::kStale || r.status == hal::OdometryStatus::kValid) {
+      log_.log(Event::kOdometry, "encoders %s", hal::to_string(r.status));
+    }
+    seen_odom_ = r.status;
+  }
+}
+
+void Daemon::enqueue(std::int64_t now_us) {
+  ++counters_.scans_received;
+  if (queue_.size() >= config_.scan_queue) {
+    queue_.pop(pending_scratch_);
+    ++counters_.scans_dropped_queue_full;
+    log_.log(Event::kScanDropped, "scan queue full (%u): oldest scan dropped (%" PRIu64 " in all)", config_.scan_queue,
+             counters_.scans_dropped_queue_full);
+  }
+  pending_scratch_.scan = scratch_;
+  pending_scratch_.read_us = now_us;
+  queue_.push(pending_scratch_);
+}
+
+void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
+  while (!queue_.empty()) {
+    PendingScan& p = queue_[0];
+    Pose2 pose;
+    const OdometryRing::Lookup l = ring_.interpolate(p.scan.stamp_us, config_.max_interpolation_gap_us, &pose);
+    if (l == OdometryRing::Lookup::kNotYet) {
+      const std::int64_t waited = now_us - p.read_us;
+      if (!final_pass && waited < config_.odometry_wait_us) return;
+      ++counters_.scans_skipped_no_odometry;
+      log_.log(Event::kScanSkipped, "no odometry reached the scan's stamp within %.0f ms (newest %.1f ms older): skipped",
+               static_cast<double>(config_.odometry_wait_us) / 1000.0,
+               ring_.empty() ? 0.0 : static_cast<double>(p.scan.stamp_us - ring_.newest_stamp_us()) / 1000.0);
+      queue_.pop(pending_scratch_);
+      continue;
+    }
+    if (l != OdometryRing::Lookup::kOk) {
+      if (l == OdometryRing::Lookup::kTooOld) ++counters_.scans_skipped_too_old;
+      else ++counters_.scans_skipped_gap;
+      log_.log(Event::kScanSkipped, "scan at %.3f s cannot be placed (%s): skipped",
+               static_cast<double>(p.scan.stamp_us - start_us_) * 1e-6, to_string(l));
+      queue_.pop(pending_scratch_);
+      continue;
+    }
+    const std::int64_t waited = now_us - p.read_us;
+    if (waited > counters_.max_odometry_wait_us) counters_.max_odometry_wait_us = waited;
+    const EngineStep s = io_.engine->process(OdometrySample{p.scan.stamp_us, pose}, p.scan);
+    ++counters_.scans_placed;
+    if (s.processed) ++counters_.scans_processed;
+    const std::int64_t done_us = io_.clock->now_us();
+    const std::int64_t from_stamp = done_us - p.scan.stamp_us;
+    const std::int64_t from_read = done_us - p.read_us;
+    stamp_latency_.push_overwrite(static_cast<std::int32_t>(std::min<std::int64_t>(from_stamp, INT32_MAX)));
+    read_latency_.push_overwrite(static_cast<std::int32_t>(std::min<std::int64_t>(from_read, INT32_MAX)));
+    stamp_latency_max_us_ = std::max(stamp_latency_max_us_, from_stamp);
+    read_latency_max_us_ = std::max(read_latency_max_us_, from_read);
+    ++latency_count_;
+    queue_.pop(pending_scratch_);
+    now_us = done_us;
+  }
+}
+
+void Daemon::watch_faults() {
+  const hal::RangeSourceHealth h = io_.laser->health();
+  const hal::RangeSourceStats& ls = io_.laser->stats();
+  if (ls.disconnect_count > seen_laser_.disconnect_count) {
+    log_.log(Event::kLaser, "laser %s disconnected (%" PRIu64 " in all): re-opening", config_.laser_device.c_str(),
+             ls.disconnect_count);
+  }
+  if (ls.restart_count > seen_laser_.restart_count) {
+    log_.log(Event::kLaser, "laser restarted (%" PRIu64 " restarts)", ls.restart_count);
+  }
+  if (ls.stall_count > seen_laser_.stall_count) {
+    log_.log(Event::kLaser, "laser stalled: no scan within %.0f ms (%" PRIu64 " stalls)",
+             static_cast<double>(config_.urg.stall_timeout_us) / 1000.0, ls.stall_count);
+  }
+  if (ls.dropped_scan_count > seen_laser_.dropped_scan_count) {
+    log_.log(Event::kLaserData, "laser driver rejected %" PRIu64 " scan(s) (checksum %" PRIu64 ", framing %" PRIu64 ")",
+             ls.dropped_scan_count - seen_laser_.dropped_scan_count, ls.checksum_error_count, ls.framing_error_count);
+  }
+  if (h != seen_health_) {
+    log_.log(Event::kLaser, "laser %s -> %s", health_name(seen_health_), health_name(h));
+    seen_health_ = h;
+  }
+  seen_laser_ = ls;
+  if (io_.bus != nullptr) {
+    const hal::CanBusState st = io_.bus->state();
+    const hal::CanBusStats& cs = io_.bus->stats();
+    if (st != seen_can_state_) {
+      log_.log(Event::kCan, "CAN %s %s -> %s", config_.can_interface.c_str(), hal::to_string(seen_can_state_),
+               hal::to_string(st));
+      seen_can_state_ = st;
+    }
+    if (cs.reopen_count > seen_can_.reopen_count) {
+      log_.log(Event::kCan, "CAN %s back (%u re-opens)", config_.can_interface.c_str(), cs.reopen_count);
+    }
+    if (cs.errors.bus_off > seen_can_.errors.bus_off) {
+      log_.log(Event::kCan, "CAN bus-off reported (%u in all)", cs.errors.bus_off);
+    }
+    if (cs.rx_overflows > seen_can_.rx_overflows) {
+      log_.log(Event::kCanData, "kernel dropped %" PRIu64 " CAN frame(s) (receive queue overflow)",
+               cs.rx_overflows - seen_can_.rx_overflows);
+    }
+    seen_can_ = cs;
+  }
+}
+
+void Daemon::step() {
+  ++counters_.loop_steps;
+  update_odometry();
+  const std::int64_t wait = queue_.empty() ? config_.loop_slice_us : std::min<std::int64_t>(config_.loop_slice_us, 1000);
+  const std::int64_t before = io_.clock->now_us();
+  const int r = io_.laser->poll(scratch_, wait);
+  std::int64_t now = io_.clock->now_us();
+  if (r == 1) {
+    enqueue(now);
+  } else if (r < 0 && now - before < wait / 2) {
+    sleep_us(wait - (now - before));  // disconnected: the driver returned at once
+    now = io_.clock->now_us();
+  }
+  update_odometry();
+  place_scans(now, false);
+  watch_faults();
+  now = io_.clock->now_us();
+  if (now >= next_output_us_) {
+    write_outputs();
+    next_output_us_ = io_.clock->now_us() + config_.output_period_us;
+  }
+}
+
+bool Daemon::run(const volatile std::sig_atomic_t* stop) {
+  while (*stop == 0) step();
+  log_.log(Event::kShutdown, "signal received: finishing");
+  return finish();
+}
+
+bool Daemon::finish() {
+  update_odometry();
+  place_scans(io_.clock->now_us(), true);
+  return write_outputs();
+}
+
+bool Daemon::write_outputs() {
+  const std::int64_t t0 = io_.clock->now_us();
+  std::string error;
+  bool ok = true;
+  const std::vector<io::StampedPose> trajectory = io_.engine->trajectory();
+  if (config_.write_map) {
+    io::OccupancyImage image;
+    io_.engine->map_image(&image);
+    ok = slam::write_trajectory_and_map(config_.output_directory, trajectory, image, &error);
+  } else {
+    ok = io::write_trajectory(config_.output_directory + "/trajectory.txt", trajectory, &error);
+  }
+  const std::int64_t dt = io_.clock->now_us() - t0;
+  if (dt > counters_.max_output_write_us) counters_.max_output_write_us = dt;
+  if (ok) {
+    ++counters_.output_writes;
+  } else {
+    ++counters_.output_failures;
+    last_output_error_ = error;
+    log_.log(Event::kOutput, "write failed, previous files kept: %s", error.c_str());
+  }
+  std::string status_error;
+  if (!io::write_file_atomic(config_.output_directory + "/status.json", status_json(), &status_error)) {
+    ++counters_.output_failures;
+    last_output_error_ = status_error;
+    log_.log(Event::kOutput, "write failed, previous file kept: %s", status_error.c_str());
+    ok = false;
+  }
+  return ok;
+}
+
+LatencyFigures Daemon::figures(const RingBuffer<std::int32_t, kLatencyWindow>& w, std::int64_t max_us,
+                               std::uint64_t count) {
+  LatencyFigures f;
+  f.count = count;
+  if (w.empty()) return f;
+  static std::int32_t sorted[kLatencyWindow];  // single-threaded program
+  const std::size_t n = w.size();
+  for (std::size_t i = 0; i < n; ++i) sorted[i] = w[i];
+  std::sort(sorted, sorted + n);
+  auto at = [&](double q) {
+    const auto idx = static_cast<std::size_t>(q * static_cast<double>(n - 1U) + 0.5);
+    return static_cast<double>(sorted[std::min(idx, n - 1U)]) / 1000.0;
+  };
+  f.p50_ms = at(0.5);
+  f.p99_ms = at(0.99);
+  f.max_ms = static_cast<double>(max_us) / 1000.0;
+  return f;
+}
+
+std::string Daemon::status_json() const {
+  const std::int64_t now = io_.clock->now_us();
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  const double user_s = static_cast<double>(ru.ru_utime.tv_sec) + static_cast<double>(ru.ru_utime.tv_usec) * 1e-6;
+  const double sys_s = static_cast<double>(ru.ru_stime.tv_sec) + static_cast<double>(ru.ru_stime.tv_usec) * 1e-6;
+  const double up_s = static_cast<double>(now - start_us_) * 1e-6;
+  auto u = [](std::uint64_t v) { return std::to_string(v); };
+  auto lat = [&](const LatencyFigures& f) {
+    return "{\"count\": " + u(f.count) + ", \"p50\": " + fmt_ms(f.p50_ms) + ", \"p99\": " + fmt_ms(f.p99_ms) +
+           ", \"max\": " + fmt_ms(f.max_ms) + "}";
+  };
+  const DaemonCounters& c = counters_;
+  const hal::RangeSourceStats& ls = io_.laser->stats();
+  const hal::OdometryReading od = odom_.latest();
+  std::string js = "{\n";
+  js += "  \"program\": \"sdpslamd\",\n  \"mode\": \"" + std::string(io_.engine->name()) + "\",\n";
+  js += "  \"uptime_s\": " + fmt_ms(up_s) + ",\n";
+  js += "  \"health\": {\"laser\": \"" + std::string(health_name(io_.laser->health())) + "\", \"can\": \"" +
+        std::string(io_.bus != nullptr ? hal::to_string(io_.bus->state()) : "none") + "\", \"odometry\": \"" +
+        hal::to_string(od.status) + "\"},\n";
+  js += "  \"scans\": {\"received\": " + u(c.scans_received) + ", \"placed\": " + u(c.scans_placed) +
+        ", \"processed\": " + u(c.scans_processed) + ", \"skipped_no_odometry\": " + u(c.scans_skipped_no_odometry) +
+        ", \"skipped_too_old\": " + u(c.scans_skipped_too_old) + ", \"skipped_gap\": " + u(c.scans_skipped_gap) +
+        ", \"dropped_queue_full\": " + u(c.scans_dropped_queue_full) + ", \"dropped_total\": " + u(c.scans_dropped()) +
+        ", \"queued\": " + u(queue_.size()) + "},\n";
+  js += "  \"latency_ms\": {\"from_scan_stamp\": " + lat(latency_from_stamp()) + ", \"from_driver_read\": " +
+        lat(latency_from_read()) + ", \"max_odometry_wait\": " +
+        fmt_ms(static_cast<double>(c.max_odometry_wait_us) / 1000.0) + "},\n";
+  js += "  \"odometry\": {\"samples\": " + u(c.odometry_samples) + ", \"stale_events\": " + u(c.odometry_stale_events) +
+        ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
+        ", \"x_m\": " + fmt_ms(od.pose.x_m) + ", \"y_m\": " + fmt_ms(od.pose.y_m) + ", \"heading_rad\": " +
+        fmt_ms(od.pose.heading_rad) + "},\n";
+  js += "  \"laser\": {\"scans\": " + u(ls.scan_count) + ", \"rejected\": " + u(ls.dropped_scan_count) +
+        ", \"checksum_errors\": " + u(ls.checksum_error_count) + ", \"framing_errors\": " +
+        u(ls.framing_error_count) + ", \"timeouts\": " + u(ls.timeout_count) + ", \"stalls\": " + u(ls.stall_count) +
+        ", \"disconnects\": " + u(ls.disconnect_count) + ", \"restarts\": " + u(ls.restart_count);
+  if (io_.laser_stream != nullptr) {
+    const hal::ByteStreamStats& bs = io_.laser_stream->stats();
+    js += ", \"opens\": " + u(bs.open_count) + ", \"hangups\": " + u(bs.hangup_count);
+  }
+  js += "},\n";
+  if (io_.bus != nullptr) {
+    const hal::CanBusStats& cs = io_.bus->stats();
+    js += "  \"can\": {\"rx_frames\": " + u(cs.rx_frames) + ", \"tx_frames\": " + u(cs.tx_frames) +
+          ", \"rx_overflows\": " + u(cs.rx_overflows) + ", \"error_frames\": " + u(cs.error_frames) +
+          ", \"bus_off\": " + u(cs.errors.bus_off) + ", \"down_count\": " + u(cs.down_count) +
+          ", \"reopen_count\": " + u(cs.reopen_count) + ", \"tx_errors\": " + u(cs.tx_errors) + "},\n";
+  }
+  js += "  \"engine\": {" + io_.engine->status_json() + "},\n";
+  js += "  \"outputs\": {\"writes\": " + u(c.output_writes) + ", \"failures\": " + u(c.output_failures) +
+        ", \"max_write_ms\": " + fmt_ms(static_cast<double>(c.max_output_write_us) / 1000.0) + "},\n";
+  js += "  \"events\": {\"logged\": " + u(log_.printed()) + ", \"suppressed\": " + u(log_.suppressed()) + "},\n";
+  js += "  \"cpu\": {\"user_s\": " + fmt_ms(user_s) + ", \"system_s\": " + fmt_ms(sys_s) + ", \"percent\": " +
+        fmt_ms(up_s > 0.0 ? 100.0 * (user_s + sys_s) / up_s : 0.0) + "}\n}\n";
+  return js;
+}
+
+}  // namespace sdpslam::daemon

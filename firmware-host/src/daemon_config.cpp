@@ -1,0 +1,395 @@
+#include "sdpslam/daemon/daemon_config.h"
+
+#include "sdpslam/drivers/serial_port.h"
+
+#include <ini.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+namespace sdpslam::daemon {
+
+const char* to_string(LaserProtocol p) { return p == LaserProtocol::kScip ? "scip" : "sick"; }
+const char* to_string(SlamMode m) { return m == SlamMode::kDpSlam ? "dpslam" : "sdp"; }
+
+namespace {
+
+struct ParseState {
+  DaemonConfig* config;
+  std::string file;
+  std::string error;
+  std::FILE* stream = nullptr;
+  int line = 0;
+};
+
+// The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
+bool known_section(const std::string& sec) {
+  static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "output", "daemon"};
+  for (const char* k : kOwn) {
+    if (sec == k) return true;
+  }
+  return slam::is_slam_config_section(sec);
+}
+
+// The packaged inih is built without INI_HANDLER_LINENO (lines are counted here) and
+// without INI_CALL_HANDLER_ON_NEW_SECTION (section headers are checked here, so an
+// unknown section is rejected at its own line even when it holds no key).
+char* read_line(char* str, int num, void* user) {
+  auto* st = static_cast<ParseState*>(user);
+  char* r = std::fgets(str, num, st->stream);
+  if (r == nullptr) return r;
+  ++st->line;
+  const char* p = r;
+  while (*p == ' ' || *p == '\t') ++p;
+  if (*p == '[' && st->error.empty()) {
+    const char* end = std::strchr(p, ']');
+    if (end != nullptr) {
+      std::string sec(p + 1, end);
+      while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
+      while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
+      if (!known_section(sec)) st->error = st->file + ":" + std::to_string(st->line) + ": unknown section [" + sec + "]";
+    }
+  }
+  return r;
+}
+
+// Value parsers: each returns false with *why set.
+bool real_in(const char* text, double lo, double hi, bool lo_open, double* out, std::string* why) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    *why = "'" + std::string(text) + "' is not a finite number";
+    return false;
+  }
+  if ((lo_open ? v <= lo : v < lo) || v > hi) {
+    char b[160];
+    std::snprintf(b, sizeof b, "%s out of range %s%g, %g]", text, lo_open ? "(" : "[", lo, hi);
+    *why = b;
+    return false;
+  }
+  *out = v;
+  return true;
+}
+
+bool int_in(const char* text, long long lo, long long hi, long long* out, std::string* why) {
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(text, &end, 0);
+  if (end == text || *end != '\0' || errno == ERANGE) {
+    *why = "'" + std::string(text) + "' is not an integer";
+    return false;
+  }
+  if (v < lo || v > hi) {
+    *why = std::string(text) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    return false;
+  }
+  *out = v;
+  return true;
+}
+
+bool boolean(const char* text, bool* out, std::string* why) {
+  const std::string t(text);
+  if (t == "true" || t == "yes" || t == "1" || t == "on") {
+    *out = true;
+    return true;
+  }
+  if (t == "false" || t == "no" || t == "0" || t == "off") {
+    *out = false;
+    return true;
+  }
+  *why = "'" + t + "' is not a boolean (true/false)";
+  return false;
+}
+
+enum class R { kOk, kUnknown, kBad };
+
+R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, const char* v, std::string* why) {
+  double d = 0.0;
+  long long i = 0;
+  auto ok = [](bool b) { return b ? R::kOk : R::kBad; };
+  auto ms = [&](std::int64_t& field, double lo, double hi, bool lo_open) {
+    if (!real_in(v, lo, hi, lo_open, &d, why)) return R::kBad;
+    field = static_cast<std::int64_t>(std::llround(d * 1000.0));
+    return R::kOk;
+  };
+  auto real = [&](double& field, double lo, double hi, bool lo_open) {
+    if (!real_in(v, lo, hi, lo_open, &d, why)) return R::kBad;
+    field = d;
+    return R::kOk;
+  };
+  if (sec == "can") {
+    drivers::CanOpenEncoderOptions& co = c.encoders.canopen;
+    drivers::ODriveEncoderOptions& od = c.encoders.odrive;
+    if (key == "interface") {
+      const std::size_t n = std::strlen(v);
+      if (n == 0U || n > 15U || std::strchr(v, '/') != nullptr || std::strchr(v, ' ') != nullptr) {
+        *why = "interface name must be 1..15 characters without '/' or spaces";
+        return R::kBad;
+      }
+      c.can_interface = v;
+      return R::kOk;
+    }
+    if (key == "protocol") {
+      if (!drivers::parse_encoder_protocol(v, c.encoders.protocol)) {
+        *why = "'" + std::string(v) + "' is not an encoder protocol (canopen, odrive)";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
+    if (key == "left_node" || key == "right_node") {
+      // CANopen node ids are 1..127 (CiA 301), ODrive axis ids 0..63 (6 bits of the 11-bit id).
+      const bool canopen = c.encoders.protocol == drivers::EncoderProtocol::kCanOpen;
+      if (!int_in(v, canopen ? 1 : 0, canopen ? 127 : 63, &i, why)) {
+        *why += canopen ? " (CANopen node id; set protocol first)" : " (ODrive axis id; set protocol first)";
+        return R::kBad;
+      }
+      const auto n = static_cast<std::uint8_t>(i);
+      (key == "left_node" ? co.left_node : co.right_node) = n;
+      (key == "left_node" ? od.left_node : od.right_node) = n;
+      if (co.left_node == co.right_node) {
+        *why = "left_node and right_node are the same node";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
+    if (key == "position_bytes") {
+      if (!int_in(v, 2, 4, &i, why) || i == 3) {
+        *why = std::string(v) + ": position_bytes must be 2 or 4";
+        return R::kBad;
+      }
+      co.position_bytes = static_cast<std::uint8_t>(i);
+      return R::kOk;
+    }
+    if (key == "send_nmt_start") return ok(boolean(v, &co.send_nmt_start, why));
+    if (key == "sync_period_ms") return ms(co.sync_period_us, 0.0, 1000.0, false);
+    if (key == "position_timeout_ms") {
+      const R r = ms(co.position_timeout_us, 1.0, 10000.0, false);
+      od.position_timeout_us = co.position_timeout_us;
+      return r;
+    }
+    if (key == "heartbeat_timeout_ms") {
+      const R r = ms(co.heartbeat_timeout_us, 0.0, 60000.0, false);
+      od.heartbeat_timeout_us = co.heartbeat_timeout_us;
+      return r;
+    }
+    if (key == "odrive_counts_per_turn") return real(od.counts_per_turn, 1.0, 1e7, false);
+    if (key == "odrive_request_period_ms") return ms(od.request_period_us, 0.0, 1000.0, false);
+    if (key == "reopen_interval_ms") return ms(c.can_reopen_interval_us, 10.0, 60000.0, false);
+  } else if (sec == "laser") {
+    if (key == "device") {
+      if (*v == '\0' || std::strlen(v) > drivers::SerialOptions::kMaxPathChars) {
+        *why = "device path must be 1..127 characters";
+        return R::kBad;
+      }
+      c.laser_device = v;
+      return R::kOk;
+    }
+    if (key == "protocol") {
+      const std::string p(v);
+      if (p == "scip") c.laser_protocol = LaserProtocol::kScip;
+      else if (p == "sick") c.laser_protocol = LaserProtocol::kSick;
+      else {
+        *why = "'" + p + "' is not a laser protocol (scip, sick)";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
+    if (key == "baud") {
+      static constexpr long long kRates[] = {9600, 19200, 38400, 57600, 115200, 230400, 250000, 460800, 500000, 750000, 921600};
+      if (!int_in(v, 1, 4000000, &i, why)) return R::kBad;
+      for (long long r : kRates) {
+        if (r == i) {
+          c.laser_baud = static_cast<std::uint32_t>(i);
+          return R::kOk;
+        }
+      }
+      *why = std::string(v) + " is not a supported line speed (9600 ... 921600)";
+      return R::kBad;
+    }
+    if (key == "scip_cluster") {
+      if (!int_in(v, 1, 99, &i, why)) return R::kBad;
+      c.urg.cluster = static_cast<std::uint32_t>(i);
+      return R::kOk;
+    }
+    if (key == "sick_baud") {
+      if (!int_in(v, 9600, 500000, &i, why)) return R::kBad;
+      c.sick.target_baud = static_cast<std::uint32_t>(i);
+      if (!drivers::validate(c.sick)) {
+        *why = std::string(v) + ": the LMS2xx offers 9600, 19200, 38400 or 500000";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
+    if (key == "sick_angle_deg" || key == "sick_resolution_cdeg") {
+      if (!int_in(v, 1, 180, &i, why)) return R::kBad;
+      (key == "sick_angle_deg" ? c.sick.angle_deg : c.sick.resolution_cdeg) = static_cast<std::uint16_t>(i);
+      return R::kOk;  // the combination is checked once the file is read
+    }
+    if (key == "reply_timeout_ms") {
+      const R r = ms(c.urg.reply_timeout_us, 10.0, 60000.0, false);
+      c.sick.reply_timeout_us = c.urg.reply_timeout_us;
+      return r;
+    }
+    if (key == "stall_timeout_ms") {
+      const R r = ms(c.urg.stall_timeout_us, 10.0, 60000.0, false);
+      c.sick.stall_timeout_us = c.urg.stall_timeout_us;
+      return r;
+    }
+    if (key == "reopen_interval_ms") return ms(c.laser_reopen_interval_us, 10.0, 60000.0, false);
+    if (key == "x_m") return real(c.laser_in_base.x_m, -10.0, 10.0, false);
+    if (key == "y_m") return real(c.laser_in_base.y_m, -10.0, 10.0, false);
+    if (key == "heading_rad") return real(c.laser_in_base.heading_rad, -det::kPi, det::kPi, false);
+  } else if (sec == "robot") {
+    drivers::DiffDriveParams& p = c.drive;
+    if (key == "ticks_per_rev") return real(p.ticks_per_rev, 0.0, 1e9, true);
+    if (key == "gear_ratio") return real(p.gear_ratio, 0.0, 1e6, true);
+    if (key == "left_radius_m") return real(p.left_radius_m, 0.0, 5.0, true);
+    if (key == "right_radius_m") return real(p.right_radius_m, 0.0, 5.0, true);
+    if (key == "wheel_separation_m") return real(p.wheel_separation_m, 0.0, 20.0, true);
+    if (key == "left_sign" || key == "right_sign") {
+      if (!int_in(v, -1, 1, &i, why) || i == 0) {
+        *why = std::string(v) + ": a direction sign is 1 or -1";
+        return R::kBad;
+      }
+      (key == "left_sign" ? p.left_sign : p.right_sign) = static_cast<int>(i);
+      return R::kOk;
+    }
+    if (key == "counter_bits") {
+      if (!int_in(v, 16, 32, &i, why) || (i != 16 && i != 32)) {
+        *why = std::string(v) + ": counter_bits must be 16 or 32";
+        return R::kBad;
+      }
+      p.counter_bits = static_cast<std::uint8_t>(i);
+      return R::kOk;
+    }
+  } else if (sec == "sync") {
+    if (key == "odometry_wait_ms") return ms(c.odometry_wait_us, 0.0, 5000.0, false);
+    if (key == "max_interpolation_gap_ms") return ms(c.max_interpolation_gap_us, 1.0, 10000.0, false);
+    if (key == "scan_queue") {
+      if (!int_in(v, 1, DaemonConfig::kMaxScanQueue, &i, why)) return R::kBad;
+      c.scan_queue = static_cast<std::uint32_t>(i);
+      return R::kOk;
+    }
+  } else if (sec == "slam") {
+    if (key == "mode") {
+      const std::string m(v);
+      if (m == "dpslam") c.mode = SlamMode::kDpSlam;
+      else if (m == "sdp") c.mode = SlamMode::kSdp;
+      else {
+        *why = "'" + m + "' is not a SLAM mode (dpslam, sdp)";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
+    if (key == "seed") {
+      if (*v == '-' || !int_in(v, 0, 0x7FFFFFFFFFFFFFFFLL, &i, why)) {
+        if (why->empty()) *why = std::string(v) + " is not a non-negative integer";
+        return R::kBad;
+      }
+      c.seed = static_cast<std::uint64_t>(i);
+      return R::kOk;
+    }
+  } else if (sec == "output") {
+    if (key == "directory") {
+      if (*v == '\0') {
+        *why = "empty output directory";
+        return R::kBad;
+      }
+      c.output_directory = v;
+      return R::kOk;
+    }
+    if (key == "period_s") {
+      if (!real_in(v, 0.1, 3600.0, false, &d, why)) return R::kBad;
+      c.output_period_us = static_cast<std::int64_t>(std::llround(d * 1e6));
+      return R::kOk;
+    }
+    if (key == "max_trajectory_scans") {
+      if (!int_in(v, 1, 10000000, &i, why)) return R::kBad;
+      c.max_trajectory_scans = static_cast<std::uint32_t>(i);
+      return R::kOk;
+    }
+    if (key == "write_map") return ok(boolean(v, &c.write_map, why));
+  } else if (sec == "daemon") {
+    if (key == "log_interval_s") {
+      if (!real_in(v, 0.0, 3600.0, false, &d, why)) return R::kBad;
+      c.log_interval_us = static_cast<std::int64_t>(std::llround(d * 1e6));
+      return R::kOk;
+    }
+    if (key == "loop_slice_ms") return ms(c.loop_slice_us, 0.1, 100.0, false);
+  } else {
+    std::string slam_why;
+    switch (slam::apply_config_key(&c.slam, sec, key, v, &slam_why)) {
+      case slam::ConfigKeyResult::kApplied: return R::kOk;
+      case slam::ConfigKeyResult::kInvalid: *why = slam_why; return R::kBad;
+      case slam::ConfigKeyResult::kUnknown:
+        if (!slam::is_slam_config_section(sec)) {
+          *why = "unknown section [" + sec + "]";
+          return R::kBad;
+        }
+        break;
+    }
+  }
+  return R::kUnknown;
+}
+
+int handler(void* user, const char* section, const char* name, const char* value) {
+  auto* st = static_cast<ParseState*>(user);
+  const std::string sec(section);
+  std::string why;
+  if (!st->error.empty()) return 0;  // an unknown section header was met
+  if (name == nullptr) {
+    if (known_section(sec)) return 1;
+    why = "unknown section [" + sec + "]";
+  } else {
+    const R r = handle_key(*st->config, sec, name, value, &why);
+    if (r == R::kOk) return 1;
+    if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
+    else if (!slam::is_slam_config_section(sec)) why = sec + "." + name + ": " + why;
+  }
+  if (st->error.empty()) st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
+  return 0;
+}
+
+}  // namespace
+
+bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
+  std::FILE* f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  ParseState st{config, path, {}, f, 0};
+  const int rc = ini_parse_stream(read_line, &st, handler, &st);
+  std::fclose(f);
+  if (!st.error.empty()) {
+    *error = st.error;
+    return false;
+  }
+  if (rc != 0) {
+    *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
+    return false;
+  }
+  // Checks that involve several keys, once everything is read.
+  const std::string at = path + ": ";
+  if (config->laser_protocol == LaserProtocol::kSick && !drivers::validate(config->sick)) {
+    *error = at + "laser: the LMS2xx has no variant sick_angle_deg = " + std::to_string(config->sick.angle_deg) +
+             ", sick_resolution_cdeg = " + std::to_string(config->sick.resolution_cdeg);
+    return false;
+  }
+  if (drivers::validate(config->drive) != drivers::DiffDriveParamsError::kOk) {
+    *error = at + "robot: " + drivers::to_string(drivers::validate(config->drive));
+    return false;
+  }
+  char why[200];
+  if (!config->slam.filter.validate(why, sizeof why)) {
+    *error = at + why;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sdpslam::daemon

@@ -1,0 +1,202 @@
+// sdpslamd: the onboard SLAM program (see firmware-host/README.md and sdpslamd.ini).
+//
+//   sdpslamd --config FILE [--out DIR] [--can-candump LOG [--can-candump-start-us T]
+//            [--can-candump-speed S]] [--check-config]
+//
+// Exit codes (as the sdpslam command): 0 stopped by SIGINT/SIGTERM with final outputs
+// written, 1 internal failure, 2 bad command line, 3 bad configuration or input,
+// 4 an output could not be written (output directory at start, final outputs at exit).
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "sdpslam/daemon/candump_replay_bus.h"
+#include "sdpslam/daemon/daemon.h"
+#include "sdpslam/drivers/can_wheel_encoders.h"
+#include "sdpslam/drivers/linux_clock.h"
+#include "sdpslam/drivers/serial_port.h"
+#include "sdpslam/drivers/sick_lms2xx_laser.h"
+#include "sdpslam/drivers/socketcan_bus.h"
+#include "sdpslam/drivers/urg_scip2_laser.h"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+enum ExitCode : int { kExitOk = 0, kExitInternal = 1, kExitUsage = 2, kExitBadInput = 3, kExitIo = 4 };
+
+int usage(const char* why) {
+  if (why != nullptr) std::fprintf(stderr, "sdpslamd: %s\n", why);
+  std::fprintf(stderr,
+               "usage: sdpslamd --config FILE [--out DIR] [--check-config]\n"
+               "                [--can-candump LOG [--can-candump-start-us T] [--can-candump-speed S]]\n"
+               "  --config FILE           INI configuration (every key: sdpslamd.ini)\n"
+               "  --out DIR               output directory (overrides [output] directory)\n"
+               "  --check-config          load and validate the configuration, then exit\n"
+               "  --can-candump LOG       replay a candump -l log as the CAN bus instead of SocketCAN\n"
+               "  --can-candump-start-us  CLOCK_MONOTONIC time (us) the log's first frame is due\n"
+               "  --can-candump-speed     replay speed factor (default 1)\n");
+  return kExitUsage;
+}
+
+int start_can_encoders(void* ctx) { return static_cast<sdpslam::drivers::CanWheelEncoders*>(ctx)->start(); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace sdpslam;
+  std::string config_path;
+  std::string out_dir;
+  std::string candump;
+  daemon::CandumpReplayOptions replay;
+  bool check_only = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](const char* name) -> const char* {
+      if (i + 1 >= argc) return nullptr;
+      (void)name;
+      return argv[++i];
+    };
+    const char* v = nullptr;
+    if (a == "--config") {
+      if ((v = value("--config")) == nullptr) return usage("--config needs a file");
+      config_path = v;
+    } else if (a == "--out") {
+      if ((v = value("--out")) == nullptr) return usage("--out needs a directory");
+      out_dir = v;
+    } else if (a == "--can-candump") {
+      if ((v = value("--can-candump")) == nullptr) return usage("--can-candump needs a file");
+      candump = v;
+    } else if (a == "--can-candump-start-us") {
+      if ((v = value(a.c_str())) == nullptr) return usage("--can-candump-start-us needs a value");
+      char* end = nullptr;
+      replay.start_us = std::strtoll(v, &end, 10);
+      if (*end != '\0' || replay.start_us <= 0) return usage("--can-candump-start-us: not a positive integer");
+    } else if (a == "--can-candump-speed") {
+      if ((v = value(a.c_str())) == nullptr) return usage("--can-candump-speed needs a value");
+      char* end = nullptr;
+      replay.speed = std::strtod(v, &end);
+      if (*end != '\0' || !(replay.speed > 0.0)) return usage("--can-candump-speed: not a positive number");
+    } else if (a == "--check-config") {
+      check_only = true;
+    } else if (a == "--help" || a == "-h") {
+      usage(nullptr);
+      return kExitOk;
+    } else {
+      return usage(("unknown argument " + a).c_str());
+    }
+  }
+  if (config_path.empty()) return usage("--config is required");
+
+  daemon::DaemonConfig config;
+  std::string error;
+  if (!daemon::load_daemon_config(config_path, &config, &error)) {
+    std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  if (!out_dir.empty()) config.output_directory = out_dir;
+  if (check_only) {
+    std::printf("%s: ok (mode %s, %u particles, laser %s on %s, encoders %s on %s, outputs in %s)\n",
+                config_path.c_str(), daemon::to_string(config.mode), config.slam.filter.particle_count,
+                daemon::to_string(config.laser_protocol), config.laser_device.c_str(),
+                drivers::to_string(config.encoders.protocol), config.can_interface.c_str(),
+                config.output_directory.c_str());
+    return kExitOk;
+  }
+
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: a blocking wait returns at once
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  drivers::LinuxMonotonicClock clock;
+  daemon::EventLog log(clock, config.log_interval_us);
+  std::unique_ptr<daemon::SlamEngine> engine = daemon::make_engine(config, &error);
+  if (!engine) {
+    std::fprintf(stderr, "sdpslamd: %s: %s\n", config_path.c_str(), error.c_str());
+    return kExitBadInput;
+  }
+
+  // CAN: SocketCAN with the protocol's receive filters, or a candump replay.
+  std::unique_ptr<hal::CanBus> bus;
+  if (!candump.empty()) {
+    auto rb = std::make_unique<daemon::CandumpReplayBus>(clock, replay);
+    if (!rb->open(candump, &error)) {
+      std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
+      return kExitBadInput;
+    }
+    bus = std::move(rb);
+  } else {
+    drivers::SocketCanOptions so;
+    std::snprintf(so.interface_name, sizeof so.interface_name, "%s", config.can_interface.c_str());
+    so.reopen_interval_us = config.can_reopen_interval_us;
+    if (!drivers::add_receive_filters(config.encoders, so)) {
+      std::fprintf(stderr, "sdpslamd: CAN receive filters do not fit\n");
+      return kExitInternal;
+    }
+    auto sb = std::make_unique<drivers::SocketCanBus>(so, clock);
+    if (sb->state() == hal::CanBusState::kDown) {
+      log.log(daemon::Event::kCan, "CAN %s cannot be opened now (%s, errno %d): retrying every %.1f s",
+              config.can_interface.c_str(), drivers::to_string(sb->last_error()), sb->last_errno(),
+              static_cast<double>(config.can_reopen_interval_us) * 1e-6);
+    }
+    bus = std::move(sb);
+  }
+  drivers::CanWheelEncoders encoders(*bus, clock, config.encoders);
+
+  // Laser on its serial device; a device that is absent now is re-opened when it appears.
+  drivers::SerialOptions po;
+  po.path = config.laser_device.c_str();
+  po.baud = config.laser_protocol == daemon::LaserProtocol::kSick ? 9600U : config.laser_baud;
+  po.reopen_interval_us = config.laser_reopen_interval_us;
+  po.reopen = true;
+  drivers::SerialPort port(po, clock);
+  if (!port.open()) {
+    log.log(daemon::Event::kLaser, "%s cannot be opened now (%s: %s): retrying every %.1f s",
+            config.laser_device.c_str(), port.last_error_step(), std::strerror(port.last_errno()),
+            static_cast<double>(config.laser_reopen_interval_us) * 1e-6);
+  }
+  std::unique_ptr<hal::RangeScanSource> laser;
+  if (config.laser_protocol == daemon::LaserProtocol::kScip) {
+    drivers::UrgOptions uo = config.urg;
+    uo.laser_in_base = config.laser_in_base;
+    laser = std::make_unique<drivers::UrgScip2Laser>(port, clock, uo);
+  } else {
+    drivers::SickOptions so = config.sick;
+    so.laser_in_base = config.laser_in_base;
+    laser = std::make_unique<drivers::SickLms2xxLaser>(port, clock, so);
+  }
+
+  daemon::DaemonIo io;
+  io.clock = &clock;
+  io.bus = bus.get();
+  io.encoders = &encoders;
+  io.start_encoders = start_can_encoders;
+  io.start_ctx = &encoders;
+  io.laser = laser.get();
+  io.laser_stream = &port;
+  io.engine = engine.get();
+  auto d = std::make_unique<daemon::Daemon>(config, io, log);
+  if (!d->start(&error)) {
+    std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
+    return kExitIo;
+  }
+  const bool ok = d->run(&g_stop);
+  const daemon::DaemonCounters& c = d->counters();
+  const daemon::LatencyFigures lf = d->latency_from_stamp();
+  std::fprintf(stderr,
+               "sdpslamd: stopped: %llu scans received, %llu placed, %llu processed, %llu dropped; latency p50 %.1f "
+               "p99 %.1f max %.1f ms; outputs %s in %s\n",
+               static_cast<unsigned long long>(c.scans_received), static_cast<unsigned long long>(c.scans_placed),
+               static_cast<unsigned long long>(c.scans_processed), static_cast<unsigned long long>(c.scans_dropped()),
+               lf.p50_ms, lf.p99_ms, lf.max_ms, ok ? "written" : "NOT written", config.output_directory.c_str());
+  return ok ? kExitOk : kExitIo;
+}

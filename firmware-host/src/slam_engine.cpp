@@ -1,0 +1,102 @@
+#include "sdpslam/daemon/slam_engine.h"
+
+#include "sdpslam/core/arena.h"
+#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/slam/slam_outputs.h"
+
+namespace sdpslam::daemon {
+namespace {
+
+// Committed poses of the filter, kept for the trajectory (capacity reserved up front).
+class PathSink final : public PoseSink {
+ public:
+  void on_committed(std::int64_t stamp_us, const Pose2& pose) override {
+    if (poses.size() < poses.capacity()) poses.push_back({stamp_us, pose});
+    else ++dropped;
+  }
+  std::vector<io::StampedPose> poses;
+  std::uint64_t dropped = 0U;
+};
+
+class DpSlamEngine final : public SlamEngine {
+ public:
+  bool init(const DaemonConfig& c, std::string* error) {
+    const DpSlamOptions& fo = c.slam.filter;
+    char why[200];
+    if (!fo.validate(why, sizeof why)) {
+      *error = std::string("invalid SLAM options: ") + why;
+      return false;
+    }
+    arena_bytes_ = DpSlamFilter::required_arena_bytes(fo);
+    buffer_.reset(new unsigned char[arena_bytes_]);
+    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
+    filter_ = std::make_unique<DpSlamFilter>();
+    if (!filter_->init(fo, *arena_, c.seed)) {
+      *error = std::string("filter init failed: ") + filter_->why();
+      return false;
+    }
+    sink_.poses.reserve(c.max_trajectory_scans);
+    filter_->set_pose_sink(&sink_);
+    scans_.reserve(c.max_trajectory_scans);
+    return true;
+  }
+
+  const char* name() const override { return "dpslam"; }
+
+  EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
+    const StepResult r = filter_->process(odom, scan);
+    EngineStep s;
+    s.processed = r.status == StepResult::Status::kProcessed;
+    s.pose = r.pose;
+    if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
+    else ++unrecorded_;
+    return s;
+  }
+
+  std::vector<io::StampedPose> trajectory() const override {
+    std::vector<io::StampedPose> path = sink_.poses;
+    filter_->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
+    return slam::assemble_trajectory(scans_, path, nullptr);
+  }
+
+  std::uint32_t map_image(io::OccupancyImage* image) const override { return slam::best_map_image(*filter_, image); }
+
+  std::string status_json() const override {
+    const DpSlamStats& st = filter_->stats();
+    const AncestryTree& tree = filter_->tree();
+    const DpMap& map = filter_->map();
+    auto u = [](std::uint64_t v) { return std::to_string(v); };
+    return "\"particles\": " + u(filter_->particle_count()) + ", \"processed\": " + u(st.processed) +
+           ", \"resamplings\": " + u(st.resamplings) + ", \"map_updates_dropped\": " + u(st.map_updates_dropped) +
+           ", \"node_fallbacks\": " + u(st.node_fallback_count) + ", \"ancestry_nodes_peak\": " + u(tree.peak_used()) +
+           ", \"ancestry_nodes_capacity\": " + u(tree.capacity()) + ", \"path_entries_exhausted\": " +
+           u(tree.path_oom_count()) + ", \"observations_peak\": " + u(map.observations_peak()) +
+           ", \"observations_capacity\": " + u(map.observation_capacity()) + ", \"arena_bytes\": " + u(arena_bytes_) +
+           ", \"committed_poses_dropped\": " + u(sink_.dropped) + ", \"unrecorded_scans\": " + u(unrecorded_);
+  }
+
+  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+
+ private:
+  std::size_t arena_bytes_ = 0U;
+  std::unique_ptr<unsigned char[]> buffer_;
+  std::unique_ptr<Arena> arena_;
+  std::unique_ptr<DpSlamFilter> filter_;
+  PathSink sink_;
+  std::vector<slam::ScanRecord> scans_;
+  std::uint64_t unrecorded_ = 0U;
+};
+
+}  // namespace
+
+std::unique_ptr<SlamEngine> make_engine(const DaemonConfig& config, std::string* error) {
+  if (config.mode == SlamMode::kSdp) {
+    *error = "mode sdp: the SDP-SLAM top level is not part of this build";
+    return nullptr;
+  }
+  auto e = std::make_unique<DpSlamEngine>();
+  if (!e->init(config, error)) return nullptr;
+  return e;
+}
+
+}  // namespace sdpslam::daemon

@@ -1,0 +1,47 @@
+#pragma once
+// Outputs of a DP-SLAM run, shared by the offline runner (`sdpslam run`) and the onboard
+// program (sdpslamd), so both write the same trajectory and map from the same filter
+// state:
+//  - assemble_trajectory: one pose per laser scan. Processed scans take the best
+//    particle's path (committed poses + its uncommitted ones); the others (skipped for
+//    lack of motion, or gaps left by path exhaustion) take the last anchored pose
+//    composed with the odometry since.
+//  - best_map_image: the best particle's occupancy grid over every tile ever written.
+//  - write_trajectory_and_map: trajectory.txt, map.pgm/.yaml and map.png (with the
+//    trajectory drawn) in out_dir, each atomically (tools/io).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/io/map_image.h"
+#include "sdpslam/io/trajectory_io.h"
+
+namespace sdpslam::slam {
+
+// One laser scan as the filter saw it.
+struct ScanRecord {
+  std::int64_t stamp_us = 0;
+  Pose2 odom;            // odometry pose given with the scan
+  Pose2 online;          // StepResult::pose at that step
+  bool processed = false;
+};
+
+// `best_path`: the filter's committed poses followed by the best particle's uncommitted
+// ones, oldest first (stamps increasing). `path_gaps` (may be null) receives the number of
+// processed scans whose pose was missing from the path.
+std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& scans,
+                                                 const std::vector<io::StampedPose>& best_path,
+                                                 std::uint64_t* path_gaps);
+
+// The best particle's map. Returns the number of known cells; `image` stays empty
+// (width 0) when nothing was ever written.
+std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* image);
+
+// Writes out_dir/trajectory.txt and, when the image is not empty, out_dir/map.pgm, map.yaml
+// and map.png. False (with `error`) at the first write that failed; the files already
+// written and the previous versions of the others stay complete.
+bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
+                              const io::OccupancyImage& image, std::string* error);
+
+}  // namespace sdpslam::slam
