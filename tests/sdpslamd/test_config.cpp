@@ -1,0 +1,126 @@
+// sdpslamd configuration: the shipped example loads; every rejection names file:line.
+#include <CppUTest/TestHarness.h>
+
+#include <cstdio>
+#include <string>
+
+#include "sdpslam/daemon/daemon_config.h"
+#include "shared_data.h"
+
+using sdpslam::daemon::DaemonConfig;
+using sdpslam::daemon::load_daemon_config;
+
+namespace {
+
+std::string write_ini(const std::string& text) {
+  static int n = 0;
+  const std::string dir = sdpslam::test::make_temp_dir("sdpslamd_config");
+  const std::string path = dir + "/c" + std::to_string(n++) + ".ini";
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  return path;
+}
+
+// Loads `text`; expects failure with an error that starts "<path>:<line>:" and contains `what`.
+void expect_rejected(const std::string& text, int line, const std::string& what) {
+  DaemonConfig c;
+  std::string error;
+  const std::string path = write_ini(text);
+  CHECK_FALSE(load_daemon_config(path, &c, &error));
+  const std::string prefix = path + ":" + std::to_string(line) + ":";
+  if (error.rfind(prefix, 0) != 0 || error.find(what) == std::string::npos) {
+    FAIL(("expected '" + prefix + " ..." + what + "', got '" + error + "'").c_str());
+  }
+}
+
+}  // namespace
+
+TEST_GROUP(SdpslamdConfig){};
+
+TEST(SdpslamdConfig, shipped_example_config_loads_with_documented_defaults) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
+  STRCMP_EQUAL("can0", c.can_interface.c_str());
+  LONGS_EQUAL(30, c.slam.filter.particle_count);
+  LONGS_EQUAL(10000, c.encoders.canopen.sync_period_us);
+  DOUBLES_EQUAL(0.33, c.drive.wheel_separation_m, 1e-12);
+  LONGS_EQUAL(5000000, c.output_period_us);
+}
+
+TEST(SdpslamdConfig, values_are_applied_to_every_part) {
+  DaemonConfig c;
+  std::string error;
+  const std::string path = write_ini(
+      "[can]\nprotocol = odrive\nleft_node = 0\nright_node = 3\n[laser]\ndevice = /dev/ttyUSB1\nprotocol = sick\n"
+      "[robot]\nleft_sign = -1\ncounter_bits = 16\n[slam]\nseed = 42\n[filter]\nparticles = 7\n[sync]\n"
+      "odometry_wait_ms = 50\n");
+  CHECK_TRUE_TEXT(load_daemon_config(path, &c, &error), error.c_str());
+  CHECK(c.encoders.protocol == sdpslam::drivers::EncoderProtocol::kODrive);
+  LONGS_EQUAL(3, c.encoders.odrive.right_node);
+  STRCMP_EQUAL("/dev/ttyUSB1", c.laser_device.c_str());
+  LONGS_EQUAL(-1, c.drive.left_sign);
+  LONGS_EQUAL(16, c.drive.counter_bits);
+  LONGS_EQUAL(42, c.seed);
+  LONGS_EQUAL(7, c.slam.filter.particle_count);
+  LONGS_EQUAL(50000, c.odometry_wait_us);
+}
+
+TEST(SdpslamdConfig, unknown_section_is_rejected_at_its_line_even_when_empty) {
+  expect_rejected("[can]\ninterface = can1\n\n[lidar]\n", 4, "unknown section [lidar]");
+}
+
+TEST(SdpslamdConfig, unknown_key_is_rejected_with_its_line) {
+  expect_rejected("[laser]\ndevice = /dev/ttyACM0\nspeed = 3\n", 3, "unknown key 'speed' in section [laser]");
+}
+
+TEST(SdpslamdConfig, out_of_range_node_id_is_rejected) {
+  expect_rejected("[can]\nprotocol = canopen\nleft_node = 128\n", 3, "out of range [1, 127]");
+}
+
+TEST(SdpslamdConfig, same_node_for_both_wheels_is_rejected) {
+  expect_rejected("[can]\nleft_node = 4\nright_node = 4\n", 3, "same node");
+}
+
+TEST(SdpslamdConfig, zero_direction_sign_is_rejected) {
+  expect_rejected("[robot]\nticks_per_rev = 4096\nleft_sign = 0\n", 3, "1 or -1");
+}
+
+TEST(SdpslamdConfig, malformed_number_is_rejected) {
+  expect_rejected("[robot]\nwheel_separation_m = 0.3x\n", 2, "not a finite number");
+}
+
+TEST(SdpslamdConfig, negative_wheel_radius_is_rejected) {
+  expect_rejected("[robot]\nleft_radius_m = -0.1\n", 2, "out of range (0");
+}
+
+TEST(SdpslamdConfig, unknown_protocols_and_modes_are_rejected) {
+  expect_rejected("[laser]\nprotocol = lms500\n", 2, "not a laser protocol");
+  expect_rejected("[can]\nprotocol = j1939\n", 2, "not an encoder protocol");
+  expect_rejected("[slam]\nmode = gmapping\n", 2, "not a SLAM mode");
+}
+
+TEST(SdpslamdConfig, slam_option_goes_through_the_offline_parser_with_its_line) {
+  expect_rejected("[slam]\nmode = dpslam\n[filter]\nparticles = 0\n", 4, "particles");
+  expect_rejected("[observation]\nno_such_key = 1\n", 2, "unknown key 'no_such_key' in section [observation]");
+}
+
+TEST(SdpslamdConfig, unsupported_baud_rate_is_rejected) {
+  expect_rejected("[laser]\nbaud = 12345\n", 2, "not a supported line speed");
+}
+
+TEST(SdpslamdConfig, scan_queue_beyond_capacity_is_rejected) {
+  expect_rejected("[sync]\nscan_queue = 17\n", 2, "out of range [1, 16]");
+}
+
+TEST(SdpslamdConfig, malformed_line_is_rejected_with_its_line) {
+  expect_rejected("[output]\nperiod_s = 2\nthis line has no equals sign\n", 3, "malformed line");
+}
+
+TEST(SdpslamdConfig, missing_file_is_reported) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_FALSE(load_daemon_config("/nonexistent/sdpslamd.ini", &c, &error));
+  CHECK(error.find("/nonexistent/sdpslamd.ini: cannot open") == 0);
+}

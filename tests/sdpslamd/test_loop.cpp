@@ -1,0 +1,328 @@
+// The sdpslamd loop with fake sensors and a fake engine: odometry placed at scan stamps,
+// waiting and skipping, stale encoders, laser hang-up and reconnection, bus-off, queue
+// exhaustion, outputs written atomically, a failed write keeping the previous files.
+#include <CppUTest/TestHarness.h>
+
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "sdpslam/daemon/daemon.h"
+#include "sdpslam/io/trajectory_io.h"
+#include "shared_data.h"
+
+using namespace sdpslam;
+using namespace sdpslam::daemon;
+
+namespace {
+
+class FakeClock final : public hal::MonotonicClock {
+ public:
+  std::int64_t now_us() const override { return t; }
+  std::int64_t t = 1000000;
+};
+
+class FakeEncoders final : public hal::WheelEncoderSource {
+ public:
+  void sample(std::uint32_t left, std::uint32_t right, std::int64_t stamp_us) {
+    for (hal::WheelTicks* w : {&s.left, &s.right}) {
+      w->raw_count = w == &s.left ? left : right;
+      w->stamp_us = stamp_us;
+      ++w->sequence;
+      w->has_sample = true;
+      w->stale = false;
+    }
+  }
+  void go_stale() { s.left.stale = s.right.stale = true; }
+  int update() override { return 0; }
+  hal::WheelEncoderSample latest() const override { return s; }
+  hal::WheelEncoderSample s;
+};
+
+class FakeLaser final : public hal::RangeScanSource {
+ public:
+  void deliver(std::int64_t stamp_us) {
+    RangeScan sc;
+    sc.stamp_us = stamp_us;
+    sc.beam_count = 2;
+    ready.push_back(sc);
+  }
+  int poll(RangeScan& out, std::int64_t) override {
+    if (unplugged) return -1;
+    if (ready.empty()) return 0;
+    out = ready.front();
+    ready.erase(ready.begin());
+    ++st.scan_count;
+    h = hal::RangeSourceHealth::kStreaming;
+    return 1;
+  }
+  void unplug() {
+    unplugged = true;
+    ++st.disconnect_count;
+    h = hal::RangeSourceHealth::kDisconnected;
+  }
+  void replug() {
+    unplugged = false;
+    ++st.restart_count;
+    h = hal::RangeSourceHealth::kStarting;
+  }
+  hal::RangeSourceHealth health() const override { return h; }
+  const hal::RangeSourceStats& stats() const override { return st; }
+  std::vector<RangeScan> ready;
+  bool unplugged = false;
+  hal::RangeSourceHealth h = hal::RangeSourceHealth::kStarting;
+  hal::RangeSourceStats st;
+};
+
+class FakeBus final : public hal::CanBus {
+ public:
+  int send(const hal::CanFrame&) override { return 1; }
+  int receive(hal::CanFrame&) override { return 0; }
+  int wait_readable(std::int64_t) override { return 0; }
+  hal::CanBusState state() const override { return s; }
+  const hal::CanBusStats& stats() const override { return st; }
+  hal::CanBusState s = hal::CanBusState::kActive;
+  hal::CanBusStats st;
+};
+
+class FakeEngine final : public SlamEngine {
+ public:
+  const char* name() const override { return "fake"; }
+  EngineStep process(const OdometrySample& odom, const RangeScan&) override {
+    got.push_back(odom);
+    return EngineStep{true, odom.pose};
+  }
+  std::vector<io::StampedPose> trajectory() const override {
+    std::vector<io::StampedPose> t;
+    for (const OdometrySample& o : got) t.push_back({o.stamp_us, o.pose});
+    return t;
+  }
+  std::uint32_t map_image(io::OccupancyImage* image) const override {
+    *image = io::OccupancyImage{};
+    return 0U;
+  }
+  std::string status_json() const override { return "\"fake\": true"; }
+  std::uint64_t unrecorded_scans() const override { return 0U; }
+  std::vector<OdometrySample> got;
+};
+
+// 2000 ticks per revolution, radius 0.077 m: 1000 ticks on both wheels = 0.2419 m ahead.
+constexpr double kMetresPer1000Ticks = 0.077 * 3.14159265358979323846;
+
+struct Rig {
+  FakeClock clock;
+  FakeEncoders enc;
+  FakeLaser laser;
+  FakeBus bus;
+  FakeEngine engine;
+  std::FILE* log_file = std::tmpfile();
+  EventLog log{clock, 0, log_file};
+  DaemonConfig config;
+  std::unique_ptr<Daemon> d;
+
+  Rig() {
+    config.output_directory = test::make_temp_dir("sdpslamd_loop");
+    config.odometry_wait_us = 200000;
+    config.output_period_us = 3600000000LL;
+    config.write_map = false;
+    config.loop_slice_us = 100;
+  }
+  ~Rig() { std::fclose(log_file); }
+  Daemon& make() {
+    DaemonIo io;
+    io.clock = &clock;
+    io.bus = &bus;
+    io.encoders = &enc;
+    io.laser = &laser;
+    io.engine = &engine;
+    d = std::make_unique<Daemon>(config, io, log);
+    std::string error;
+    CHECK_TRUE_TEXT(d->start(&error), error.c_str());
+    return *d;
+  }
+  // Odometry sample of `ticks` on both wheels at t, then one loop step at t.
+  void odom(std::uint32_t ticks, std::int64_t t) {
+    clock.t = t;
+    enc.sample(ticks, ticks, t);
+    d->step();
+  }
+};
+
+bool file_exists(const std::string& p) {
+  struct stat st{};
+  return ::stat(p.c_str(), &st) == 0;
+}
+
+int temp_files_in(const std::string& dir) {
+  int n = 0;
+  DIR* d = opendir(dir.c_str());
+  while (dirent* e = readdir(d)) n += std::string(e->d_name).find(".tmp") != std::string::npos ? 1 : 0;
+  closedir(d);
+  return n;
+}
+
+}  // namespace
+
+TEST_GROUP(SdpslamdLoop){};
+
+TEST(SdpslamdLoop, scan_between_two_odometry_samples_gets_the_interpolated_pose) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.odom(1000, 1100000);
+  r.laser.deliver(1050000);
+  r.d->step();
+  LONGS_EQUAL(1, r.engine.got.size());
+  LONGS_EQUAL(1050000, r.engine.got[0].stamp_us);
+  DOUBLES_EQUAL(kMetresPer1000Ticks / 2.0, r.engine.got[0].pose.x_m, 1e-9);
+}
+
+TEST(SdpslamdLoop, scan_newer_than_odometry_waits_for_it_then_is_placed) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.laser.deliver(1050000);
+  r.clock.t = 1060000;
+  r.d->step();
+  LONGS_EQUAL(0, r.engine.got.size());
+  LONGS_EQUAL(1, r.d->queued_scans());
+  r.odom(1000, 1100000);
+  LONGS_EQUAL(1, r.engine.got.size());
+  LONGS_EQUAL(0, r.d->counters().scans_dropped());
+}
+
+TEST(SdpslamdLoop, stale_encoders_make_scans_wait_then_skip_and_count) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.odom(100, 1100000);
+  r.enc.go_stale();
+  r.laser.deliver(1150000);
+  r.clock.t = 1160000;
+  r.d->step();
+  LONGS_EQUAL(0, r.engine.got.size());
+  r.clock.t = 1160000 + r.config.odometry_wait_us;
+  r.d->step();
+  LONGS_EQUAL(0, r.engine.got.size());
+  LONGS_EQUAL(1, r.d->counters().scans_skipped_no_odometry);
+  LONGS_EQUAL(1, r.d->counters().odometry_stale_events);
+  CHECK(r.log.count(Event::kOdometry) >= 1U);
+}
+
+TEST(SdpslamdLoop, no_motion_is_invented_across_a_stale_outage) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.odom(100, 1100000);
+  r.clock.t = 1150000;
+  r.enc.go_stale();
+  r.d->step();
+  r.odom(5000, 1300000);  // re-latch after the outage
+  r.odom(5100, 1400000);
+  r.laser.deliver(1200000);  // measured during the outage
+  r.laser.deliver(1350000);  // after it
+  r.d->step();
+  r.d->step();
+  LONGS_EQUAL(1, r.d->counters().scans_skipped_gap);
+  LONGS_EQUAL(1, r.engine.got.size());
+  LONGS_EQUAL(1350000, r.engine.got[0].stamp_us);
+  // The pose continues from the last known one: the 4900 ticks of the outage are not used.
+  DOUBLES_EQUAL((100.0 + 50.0) / 1000.0 * kMetresPer1000Ticks, r.engine.got[0].pose.x_m, 1e-9);
+}
+
+TEST(SdpslamdLoop, laser_hangup_is_logged_and_scans_resume_after_reconnection) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.laser.deliver(1010000);
+  r.odom(10, 1020000);
+  LONGS_EQUAL(1, r.engine.got.size());
+  r.laser.unplug();
+  r.clock.t = 1030000;
+  r.d->step();
+  r.laser.replug();
+  r.laser.deliver(1040000);
+  r.odom(20, 1050000);
+  LONGS_EQUAL(2, r.engine.got.size());
+  CHECK(r.log.count(Event::kLaser) >= 2U);  // disconnected, restarted (health changes too)
+  CHECK(r.d->status_json().find("\"disconnects\": 1") != std::string::npos);
+}
+
+TEST(SdpslamdLoop, bus_off_and_recovery_are_logged_and_the_loop_keeps_running) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.bus.s = hal::CanBusState::kBusOff;
+  r.bus.st.errors.bus_off = 1;
+  r.clock.t = 1010000;
+  r.d->step();
+  CHECK(r.d->status_json().find("\"can\": \"bus-off\"") != std::string::npos);
+  r.bus.s = hal::CanBusState::kActive;
+  r.bus.st.reopen_count = 1;
+  r.odom(10, 1020000);
+  r.laser.deliver(1015000);
+  r.d->step();
+  LONGS_EQUAL(1, r.engine.got.size());
+  CHECK(r.log.count(Event::kCan) >= 3U);  // bus-off state, bus-off counter, back to active
+}
+
+TEST(SdpslamdLoop, full_scan_queue_drops_the_oldest_and_counts_it) {
+  Rig r;
+  r.config.scan_queue = 2;
+  r.make();
+  r.odom(0, 1000000);
+  for (int i = 1; i <= 3; ++i) {
+    r.laser.deliver(1000000 + i * 1000);
+    r.clock.t = 1000000 + i * 1000 + 10;
+    r.d->step();
+  }
+  LONGS_EQUAL(1, r.d->counters().scans_dropped_queue_full);
+  r.odom(10, 1100000);
+  LONGS_EQUAL(2, r.engine.got.size());
+  LONGS_EQUAL(1002000, r.engine.got[0].stamp_us);
+}
+
+TEST(SdpslamdLoop, finish_places_what_it_can_and_writes_outputs_atomically) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.laser.deliver(1050000);
+  r.odom(100, 1100000);
+  r.laser.deliver(1200000);  // no odometry will come: skipped at the final pass
+  r.clock.t = 1210000;
+  r.d->step();
+  CHECK_TRUE(r.d->finish());
+  std::vector<io::StampedPose> t;
+  std::string error;
+  CHECK_TRUE_TEXT(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error), error.c_str());
+  LONGS_EQUAL(1, t.size());
+  LONGS_EQUAL(1, r.d->counters().scans_skipped_no_odometry);
+  CHECK_TRUE(file_exists(r.config.output_directory + "/status.json"));
+  LONGS_EQUAL(0, temp_files_in(r.config.output_directory));
+}
+
+TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.laser.deliver(1050000);
+  r.odom(100, 1100000);
+  CHECK_TRUE(r.d->write_outputs());
+  // status.json cannot be replaced while a directory stands in its place.
+  const std::string status = r.config.output_directory + "/status.json";
+  CHECK_EQUAL(0, std::remove(status.c_str()));
+  CHECK_EQUAL(0, ::mkdir(status.c_str(), 0755));
+  r.laser.deliver(1150000);
+  r.odom(200, 1200000);
+  CHECK_FALSE(r.d->write_outputs());
+  LONGS_EQUAL(1, r.d->counters().output_failures);
+  CHECK(r.log.count(Event::kOutput) == 1U);
+  std::vector<io::StampedPose> t;
+  std::string error;
+  CHECK_TRUE(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error));
+  LONGS_EQUAL(2, t.size());
+  ::rmdir(status.c_str());
+}
