@@ -8,8 +8,8 @@
 //       [--can-iface IF --candump FILE]                      frames on SocketCAN
 //       [--daemon SDPSLAMD --config INI --out DIR --candump FILE [--tail-s T]]
 //                                                           host: runs sdpslamd, SIGTERM at the end
-// Prints the emulator's counters; exit 0 iff nothing was dropped and (host mode) sdpslamd
-// exited 0.
+// Prints the emulator's counters and the timeline (to map sdpslamd's monotonic stamps back
+// to log time); exit 0 iff every CAN frame was sent and (host mode) sdpslamd exited 0.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -130,9 +130,13 @@ int main(int argc, char** argv) {
     std::printf(" frames %zu sent %llu dropped %llu", frames.size(), static_cast<unsigned long long>(ps.frames_sent),
                 static_cast<unsigned long long>(ps.frames_dropped));
   }
-  std::printf(" wall_s %.2f\n", static_cast<double>(ps.wall_us) * 1e-6);
+  std::printf(" wall_s %.2f\ntimeline: play_start_us %lld log_start_us %lld speed %g\n",
+              static_cast<double>(ps.wall_us) * 1e-6, static_cast<long long>(player.timeline().play_start_us),
+              static_cast<long long>(player.timeline().log_start_us), speed);
   std::fflush(stdout);
-  bool ok = l.scans_dropped == 0 && l.scans_not_requested == 0 && ps.frames_dropped == 0;
+  // Scans the emulator itself dropped (its process woken late on a loaded machine) are
+  // reported, not failed: the tests judge sdpslamd's own counters.
+  bool ok = ps.frames_dropped == 0;
   if (child > 0) {
     // Keep the pty open while sdpslamd places the last scans, then stop it.
     const std::int64_t tail_end = clock.now_us() + static_cast<std::int64_t>(tail_s * 1e6);

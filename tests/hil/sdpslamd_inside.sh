@@ -1,0 +1,26 @@
+# Runs inside the virtual-CAN machine (tests/hil/run_in_vm.sh): the unmodified sdpslamd
+# (static) reads encoder frames from vcan0 and the emulated URG on a pty, while the player
+# replays the log on both at SPEED; SIGTERM at the end, then the outputs are printed
+# between markers for the host to compare. Arguments: LINES SPEED
+lines=$1
+speed=$2
+ip link add dev vcan0 type vcan && ip link set up vcan0 || exit 10
+mkdir -p /tmp/out
+./sdpslamd_static --config ./sdpslamd.ini --out /tmp/out 2>/tmp/daemon.log &
+pid=$!
+./sdpslamd_replay_static --log ./log.dat --link /tmp/laser --lines "$lines" --speed "$speed" --delay-s 4 \
+  --can-iface vcan0 --candump ./ticks.candump
+replay_rc=$?
+sleep 2
+kill -TERM $pid
+wait $pid
+daemon_rc=$?
+cat /tmp/daemon.log
+echo "@@STATUS"
+cat /tmp/out/status.json
+echo "@@TRAJECTORY"
+cat /tmp/out/trajectory.txt
+echo "@@END"
+ls /tmp/out | grep -q '\.tmp' && echo "temporary files left in /tmp/out" && daemon_rc=20
+echo "replay exit $replay_rc, sdpslamd exit $daemon_rc"
+[ $replay_rc = 0 ] && [ $daemon_rc = 0 ]
