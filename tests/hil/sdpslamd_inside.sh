@@ -5,6 +5,9 @@
 lines=$1
 speed=$2
 ip link add dev vcan0 type vcan && ip link set up vcan0 || exit 10
+# The laser emulator needs pseudo-terminals: the machine's /init mounts no devpts.
+mkdir -p /dev/pts && mount -t devpts -o ptmxmode=0666 devpts /dev/pts 2>/dev/null
+[ -e /dev/ptmx ] || ln -s pts/ptmx /dev/ptmx
 mkdir -p /tmp/out
 ./sdpslamd_static --config ./sdpslamd.ini --out /tmp/out 2>/tmp/daemon.log &
 pid=$!
