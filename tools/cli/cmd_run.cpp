@@ -1,71 +1,127 @@
-// `sdpslam run LOG --mode dpslam --particles N [--config FILE.ini] [--seed S] --out DIR`:
-// runs the bottom-level DP-SLAM filter over a log (tools/slam/run_offline.h).
+// `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
+//               [--topology sdp|segslam] [--config FILE.ini] [--sdp-config FILE.ini]
+//               [--seed S] --out DIR`
+// sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
+// (tools/slam/run_sdp.h); dpslam: the bottom-level DP-SLAM filter alone, the baseline
+// (tools/slam/run_offline.h).
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "cli_common.h"
 #include "sdpslam/slam/run_offline.h"
+#include "sdpslam/slam/run_sdp.h"
 
 namespace sdpslam::cli {
 namespace {
 
 struct RunArgs {
   std::string log;
-  std::string mode = "dpslam";
-  std::uint32_t particles = 0U;  // 0 = from the config
+  std::string mode = "sdp";
+  std::uint32_t particles = 0U;      // 0 = dpslam: from the config; sdp: 10
+  std::uint32_t top_particles = 0U;  // 0 = from the sdp config (60)
+  std::string topology;
   std::string config;
+  std::string sdp_config;
   std::uint64_t seed = 1U;
   std::string out;
 };
 
+constexpr std::uint32_t kSdpDefaultBottomParticles = 10U;  // paper §IV, "60T/10B"
+
+int report(const char* what, int code, const std::string& error) {
+  std::fprintf(stderr, "sdpslam run: %s%s\n", what, error.c_str());
+  return code;
+}
+
+int run_sdp_mode(const RunArgs& a, slam::SlamConfig config) {
+  slam::SdpRunOptions ro;
+  ro.config = config;
+  std::string error;
+  if (!a.sdp_config.empty() && !slam::load_sdp_ini(a.sdp_config, &ro.sdp, &error)) {
+    return report("", kExitBadInput, error);
+  }
+  ro.config.filter.particle_count = a.particles != 0U ? a.particles : kSdpDefaultBottomParticles;
+  if (a.top_particles != 0U) ro.sdp.top_particles = a.top_particles;
+  if (!a.topology.empty()) {
+    if (slam::apply_sdp_key(&ro.sdp, "topology", a.topology.c_str(), &error) != slam::SdpKeyResult::kApplied) {
+      return report("", kExitUsage, error);
+    }
+  }
+  char why[200];
+  if (!ro.config.filter.validate(why, sizeof why) || !ro.sdp.validate(why, sizeof why)) {
+    return report("", kExitUsage, why);
+  }
+  ro.seed = a.seed;
+  ro.progress = true;
+  slam::SdpRunSummary s;
+  switch (slam::run_sdp_offline(a.log, ro, a.out, &s, &error)) {
+    case slam::SdpRunStatus::kOk:
+      std::fprintf(stderr,
+                   "sdpslam run: %llu scans (%llu processed, %llu segments) in %.1f s, %zu log errors; ICP error "
+                   "%.3f +- %.3f m over %llu samples; outputs in %s\n",
+                   static_cast<unsigned long long>(s.scans), static_cast<unsigned long long>(s.processed),
+                   static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
+                   s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
+      return kExitOk;
+    case slam::SdpRunStatus::kBadInput: return report("", kExitBadInput, error);
+    case slam::SdpRunStatus::kIoError: return report("", kExitIo, error);
+    default: return report("internal error: ", kExitInternal, error);
+  }
+}
+
+int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
+  slam::RunOptions ro;
+  ro.config = config;
+  if (a.particles != 0U) ro.config.filter.particle_count = a.particles;
+  char why[200];
+  if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
+  ro.seed = a.seed;
+  ro.progress = true;
+  slam::RunSummary summary;
+  std::string error;
+  const slam::RunStatus st = slam::run_offline(a.log, ro, a.out, &summary, &error);
+  switch (st) {
+    case slam::RunStatus::kOk:
+      std::fprintf(stderr, "sdpslam run: %llu scans (%llu processed) in %.1f s, %zu log errors; outputs in %s\n",
+                   static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
+                   summary.wall_time_s, summary.log_error_count, a.out.c_str());
+      return kExitOk;
+    case slam::RunStatus::kBadInput: return report("", kExitBadInput, error);
+    case slam::RunStatus::kIoError: return report("", kExitIo, error);
+    default: return report("internal error: ", kExitInternal, error);
+  }
+}
+
 std::function<int()> setup_run(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
   app.add_option("log", args->log, "Robot log (CARMEN .clf[.gz], tinySLAM .dat, DP-SLAM .log)")->required();
-  app.add_option("--mode", args->mode, "Algorithm: dpslam (the bottom-level DP-SLAM filter)")
-      ->check(CLI::IsMember({"dpslam"}));
-  app.add_option("--particles", args->particles, "Bottom-level particles (overrides [filter] particles)");
-  app.add_option("--config", args->config, "INI options (see tools/slam/default.ini)");
+  app.add_option("--mode", args->mode,
+                 "Algorithm: sdp (Segmented DP-SLAM, default) or dpslam (the bottom-level DP-SLAM filter alone)")
+      ->check(CLI::IsMember({"sdp", "dpslam"}))
+      ->capture_default_str();
+  app.add_option("--particles", args->particles,
+                 "Bottom-level particles (sdp: default 10; dpslam: overrides [filter] particles)");
+  app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)");
+  app.add_option("--topology", args->topology, "sdp: topology estimation, sdp (default) or segslam (local analysis)")
+      ->check(CLI::IsMember({"sdp", "segslam"}));
+  app.add_option("--config", args->config, "INI options of the bottom level (see tools/slam/default.ini)");
+  app.add_option("--sdp-config", args->sdp_config, "sdp: INI file with an [sdp] section (see tools/slam/sdp.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)");
   app.add_option("--out", args->out, "Output directory")->required();
   return [args]() -> int {
-    slam::RunOptions ro;
+    slam::SlamConfig config;
     std::string error;
-    if (!args->config.empty() && !slam::load_config_ini(args->config, &ro.config, &error)) {
-      std::fprintf(stderr, "sdpslam run: %s\n", error.c_str());
-      return kExitBadInput;
+    if (!args->config.empty() && !slam::load_config_ini(args->config, &config, &error)) {
+      return report("", kExitBadInput, error);
     }
-    if (args->particles != 0U) ro.config.filter.particle_count = args->particles;
-    char why[200];
-    if (!ro.config.filter.validate(why, sizeof why)) {
-      std::fprintf(stderr, "sdpslam run: %s\n", why);
-      return kExitUsage;
-    }
-    ro.seed = args->seed;
-    ro.progress = true;
-    slam::RunSummary summary;
-    const slam::RunStatus st = slam::run_offline(args->log, ro, args->out, &summary, &error);
-    switch (st) {
-      case slam::RunStatus::kOk:
-        std::fprintf(stderr, "sdpslam run: %llu scans (%llu processed) in %.1f s, %zu log errors; outputs in %s\n",
-                     static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
-                     summary.wall_time_s, summary.log_error_count, args->out.c_str());
-        return kExitOk;
-      case slam::RunStatus::kBadInput:
-        std::fprintf(stderr, "sdpslam run: %s\n", error.c_str());
-        return kExitBadInput;
-      case slam::RunStatus::kIoError:
-        std::fprintf(stderr, "sdpslam run: %s\n", error.c_str());
-        return kExitIo;
-      default:
-        std::fprintf(stderr, "sdpslam run: internal error: %s\n", error.c_str());
-        return kExitInternal;
-    }
+    return args->mode == "dpslam" ? run_dpslam_mode(*args, config) : run_sdp_mode(*args, config);
   };
 }
 
 }  // namespace
 
-SDPSLAM_REGISTER_COMMAND(run, "run", "Run SLAM over a log: trajectory, map and stats", 40, setup_run);
+SDPSLAM_REGISTER_COMMAND(run, "run", "Run SLAM over a log (SDP-SLAM by default): trajectory, map and stats", 40,
+                         setup_run);
 
 }  // namespace sdpslam::cli

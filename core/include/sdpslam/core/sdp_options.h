@@ -68,9 +68,9 @@ struct SdpOptions {
   Icp2dOptions icp{};
 
   SdpOptions() {
-    icp.max_iterations = 30U;
-    icp.max_correspondence_m = 1.0;
-    icp.nn_cell_m = 0.2;
+    icp.max_iterations = 20U;
+    icp.max_correspondence_m = 0.6;
+    icp.nn_cell_m = 0.3;
     icp.min_pairs = 20U;
   }
 

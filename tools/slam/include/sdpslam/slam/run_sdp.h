@@ -1,0 +1,60 @@
+#pragma once
+// Offline SDP-SLAM runner (`sdpslam run --mode sdp`, the default): reads a robot log,
+// feeds every laser scan with its odometry to SdpSlam (core/sdp_slam.h) and writes into
+// out_dir:
+//  - trajectory.txt   one "t x y theta" line per laser scan, exactly as in dpslam mode (the
+//                     scan's stamp to the µs), in the global frame (the first segment's
+//                     frame = the first scan's pose at the origin) for the best
+//                     combination of submaps: permanent segments, the live levels' chosen
+//                     submaps and the current segment's best particle; scans that were
+//                     not processed take the last estimate composed with the odometry;
+//  - map.pgm/.yaml,   the global map (Fig. 3 (j)-(l)): the permanent map node plus each
+//    map.png          chosen submap's DP-map view transformed into the global frame,
+//                     hits and misses summed per cell; the PNG has the trajectory drawn;
+//  - icp_error.csv    "stamp_s,mean_m,std_m,samples": mean and std of the ICP error of
+//                     the top-level samples of every evaluation round that matched
+//                     something (Figs. 6-7), and icp_error.png, its line plot;
+//  - stats.json       counts, pools and their high-water marks, exhaustion counters,
+//                     Table I's μ/σ over all samples; "timing" holds the only
+//                     non-deterministic fields (wall time, per-scan times, RSS).
+// Same log, options and seed -> bit-identical trajectory.txt, map and icp_error.csv.
+#include <cstdint>
+#include <string>
+
+#include "sdpslam/core/sdp_options.h"
+#include "sdpslam/slam/config_ini.h"
+
+namespace sdpslam::slam {
+
+struct SdpRunOptions {
+  SlamConfig config;      // bottom level ([filter] particles = B) and log options
+  SdpOptions sdp;         // [sdp]
+  std::uint64_t seed = 1U;
+  bool progress = false;
+};
+
+struct SdpRunSummary {
+  std::uint64_t scans = 0U;
+  std::uint64_t processed = 0U;
+  std::uint64_t segments = 0U;
+  std::size_t log_error_count = 0U;
+  double wall_time_s = 0.0;
+  double icp_error_mean_m = 0.0;
+  double icp_error_std_m = 0.0;
+  std::uint64_t icp_error_samples = 0U;
+};
+
+enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };
+
+SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
+                             SdpRunSummary* summary, std::string* error);
+
+// Applies `[sdp] key = value` to *options. kApplied / kUnknown (not an sdp key) /
+// kInvalid (malformed value or out of range; *why says why).
+enum class SdpKeyResult { kApplied, kUnknown, kInvalid };
+SdpKeyResult apply_sdp_key(SdpOptions* options, const std::string& key, const char* value, std::string* why);
+// Reads only the [sdp] section of an INI file (other sections are ignored). False iff the
+// file cannot be read or an [sdp] line is malformed/unknown/out of range ("file:line: why").
+bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error);
+
+}  // namespace sdpslam::slam

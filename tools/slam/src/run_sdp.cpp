@@ -1,0 +1,505 @@
+#include "sdpslam/slam/run_sdp.h"
+
+#include <ini.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/log_reader.h"
+#include "sdpslam/io/map_image.h"
+#include "sdpslam/io/trajectory_io.h"
+
+namespace sdpslam::slam {
+namespace {
+
+// ---- [sdp] keys ---------------------------------------------------------------------
+
+bool parse_double(const char* v, double* out) {
+  char* end = nullptr;
+  errno = 0;
+  const double d = std::strtod(v, &end);
+  if (end == v || errno != 0 || !std::isfinite(d)) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  if (*end != '\0') return false;
+  *out = d;
+  return true;
+}
+bool parse_u32(const char* v, std::uint32_t* out) {
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long u = std::strtoull(v, &end, 10);
+  if (end == v || errno != 0 || u > 0xFFFFFFFFULL || v[0] == '-') return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  if (*end != '\0') return false;
+  *out = static_cast<std::uint32_t>(u);
+  return true;
+}
+
+struct IniState {
+  SdpOptions* options;
+  std::string why;
+};
+
+int sdp_handler(void* user, const char* section, const char* name, const char* value) {
+  auto* st = static_cast<IniState*>(user);
+  if (std::strcmp(section, "sdp") != 0) return 1;
+  const SdpKeyResult r = apply_sdp_key(st->options, name, value, &st->why);
+  if (r == SdpKeyResult::kUnknown) {
+    st->why = std::string("unknown key [sdp] ") + name;
+    return 0;
+  }
+  return r == SdpKeyResult::kApplied ? 1 : 0;
+}
+
+// ---- outputs ------------------------------------------------------------------------
+
+class CollectSink final : public PoseSink {
+ public:
+  void on_committed(std::int64_t stamp_us, const Pose2& pose) override { poses.push_back({stamp_us, pose}); }
+  std::vector<io::StampedPose> poses;
+};
+
+struct Row {
+  std::int64_t stamp_us;
+  double mean_m;
+  double std_m;
+  std::uint32_t samples;
+};
+
+class Rows final : public TopLevelListener {
+ public:
+  void on_round(std::int64_t stamp_us, double mean_m, double std_m, std::uint32_t samples) override {
+    rows.push_back(Row{stamp_us, mean_m, std_m, samples});
+  }
+  std::vector<Row> rows;
+};
+
+struct ScanLog {
+  std::int64_t stamp_us;
+  Pose2 odom;
+  Pose2 online;
+  bool processed;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1U) + 0.5);
+  return v[std::min(idx, v.size() - 1U)];
+}
+
+std::string fmt(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+// The best combination's global map: every view's known cells moved into the global frame
+// (nearest cell), hits and misses summed per cell.
+std::uint32_t global_map_image(const SdpSlam& slam, io::OccupancyImage* image) {
+  const DpSlamFilter& f = slam.bottom();
+  const DpMap& map = f.map();
+  const double res = map.resolution_m();
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  // Bounds in the global frame.
+  double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
+  slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    const double xs[2] = {ox + r.ix0 * res, ox + (r.ix0 + static_cast<double>(r.width)) * res};
+    const double ys[2] = {oy + r.iy0 * res, oy + (r.iy0 + static_cast<double>(r.height)) * res};
+    for (double x : xs) {
+      for (double y : ys) {
+        double gx = 0.0, gy = 0.0;
+        frame.transform_point(x, y, gx, gy);
+        gx0 = std::min(gx0, gx);
+        gy0 = std::min(gy0, gy);
+        gx1 = std::max(gx1, gx);
+        gy1 = std::max(gy1, gy);
+      }
+    }
+  });
+  if (!(gx1 > gx0) || !(gy1 > gy0)) return 0U;
+  // Aligned to the DP map's grid so that an identity frame maps cells exactly.
+  const double ax0 = ox + std::floor((gx0 - ox) / res) * res;
+  const double ay0 = oy + std::floor((gy0 - oy) / res) * res;
+  const auto w = static_cast<std::uint32_t>(std::ceil((gx1 - ax0) / res)) + 1U;
+  const auto h = static_cast<std::uint32_t>(std::ceil((gy1 - ay0) / res)) + 1U;
+  std::vector<CellObservation> sum(static_cast<std::size_t>(w) * h);
+  std::vector<std::uint8_t> any(sum.size(), 0U);
+  std::uint32_t known_cells = 0U;
+  slam.for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
+    std::vector<std::uint8_t> k(v.size(), 0U);
+    map.fill_rect(node, r, v.data(), k.data());
+    for (std::uint32_t y = 0; y < r.height; ++y) {
+      for (std::uint32_t x = 0; x < r.width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
+        if (k[i] == 0U) continue;
+        double cx = 0.0, cy = 0.0, gx = 0.0, gy = 0.0;
+        map.cell_center(r.ix0 + static_cast<std::int32_t>(x), r.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
+        frame.transform_point(cx, cy, gx, gy);
+        const double fx = std::floor((gx - ax0) / res);
+        const double fy = std::floor((gy - ay0) / res);
+        if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) continue;
+        const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
+        sum[g] = accumulate(sum[g], v[i].hits, v[i].misses);
+        any[g] = 1U;
+      }
+    }
+  });
+  image->width = w;
+  image->height = h;
+  image->resolution_m = res;
+  image->origin_x_m = ax0;
+  image->origin_y_m = ay0;
+  image->occupancy.assign(sum.size(), -1.0F);
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    if (any[i] == 0U) continue;
+    image->occupancy[i] = static_cast<float>(f.occupancy(sum[i]));
+    ++known_cells;
+  }
+  return known_cells;
+}
+
+// Line plot of the per-round ICP error (mean, with a ±std band), rasterised on an
+// occupancy canvas: white background, black axes, grey band, the mean drawn in colour
+// by the map PNG writer's trajectory overlay.
+bool write_error_plot(const std::string& path, const std::vector<Row>& rows, std::int64_t t0_us, std::int64_t t1_us,
+                      std::string* error) {
+  constexpr std::uint32_t kW = 640U, kH = 320U, kMargin = 20U;
+  io::OccupancyImage img;
+  img.width = kW;
+  img.height = kH;
+  img.resolution_m = 1.0;
+  img.occupancy.assign(static_cast<std::size_t>(kW) * kH, 0.0F);
+  auto put = [&img](std::int64_t x, std::int64_t y, float v) {
+    if (x >= 0 && y >= 0 && x < kW && y < kH) img.occupancy[static_cast<std::size_t>(y) * kW + static_cast<std::size_t>(x)] = v;
+  };
+  for (std::uint32_t x = kMargin; x < kW - kMargin / 2U; ++x) put(x, kMargin, 1.0F);
+  for (std::uint32_t y = kMargin; y < kH - kMargin / 2U; ++y) put(kMargin, y, 1.0F);
+  double emax = 0.0;
+  for (const Row& r : rows) emax = std::max(emax, r.mean_m + r.std_m);
+  if (!(emax > 0.0)) emax = 1.0;
+  // Tick every 0.5 m (or 0.1 m for small errors) on the y axis.
+  const double tick = emax > 2.0 ? 0.5 : 0.1;
+  const double span_t = std::max(1.0, static_cast<double>(t1_us - t0_us) * 1e-6);
+  const double sx = static_cast<double>(kW - 2U * kMargin) / span_t;
+  const double sy = static_cast<double>(kH - 2U * kMargin) / emax;
+  for (double e = tick; e <= emax; e += tick) {
+    const auto y = static_cast<std::int64_t>(kMargin + e * sy);
+    for (std::int64_t x = kMargin - 4; x < static_cast<std::int64_t>(kMargin); ++x) put(x, y, 1.0F);
+  }
+  std::vector<io::StampedPose> line;
+  for (const Row& r : rows) {
+    const double x = kMargin + static_cast<double>(r.stamp_us - t0_us) * 1e-6 * sx;
+    const auto y0 = static_cast<std::int64_t>(kMargin + std::max(0.0, r.mean_m - r.std_m) * sy);
+    const auto y1 = static_cast<std::int64_t>(kMargin + (r.mean_m + r.std_m) * sy);
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      put(static_cast<std::int64_t>(x), y, 0.5F);
+      put(static_cast<std::int64_t>(x) + 1, y, 0.5F);
+    }
+    line.push_back(io::StampedPose{r.stamp_us, Pose2{x + 0.5, kMargin + r.mean_m * sy + 0.5, 0.0}});
+  }
+  return io::write_map_png(path, img, line, error);
+}
+
+}  // namespace
+
+SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* value, std::string* why) {
+  SdpOptions t = *o;
+  double d = 0.0;
+  std::uint32_t u = 0U;
+  auto real = [&](double* field) {
+    if (!parse_double(value, &d)) return false;
+    *field = d;
+    return true;
+  };
+  auto integer = [&](std::uint32_t* field) {
+    if (!parse_u32(value, &u)) return false;
+    *field = u;
+    return true;
+  };
+  bool ok = true;
+  const std::string v = value;
+  if (key == "top_particles") ok = integer(&t.top_particles);
+  else if (key == "topology") {
+    if (v == "sdp") t.topology = TopologyMode::kSdp;
+    else if (v == "segslam") t.topology = TopologyMode::kSegSlam;
+    else ok = false;
+  } else if (key == "segslam_window") ok = integer(&t.segslam_window);
+  else if (key == "elite_fraction") ok = real(&t.elite_fraction);
+  else if (key == "worst_fraction") ok = real(&t.worst_fraction);
+  else if (key == "diversify_levels") ok = integer(&t.diversify_levels);
+  else if (key == "follow_best_fraction") ok = real(&t.follow_best_fraction);
+  else if (key == "rounds_per_segment") ok = integer(&t.rounds_per_segment);
+  else if (key == "evaluations_per_scan") ok = integer(&t.evaluations_per_scan);
+  else if (key == "max_pairs_per_sample") ok = integer(&t.max_pairs_per_sample);
+  else if (key == "overlap_margin_m") ok = real(&t.overlap_margin_m);
+  else if (key == "min_overlap_m2") ok = real(&t.min_overlap_m2);
+  else if (key == "segmentation") {
+    if (v == "periodic") t.segmentation = SegmentationMode::kPeriodic;
+    else if (v == "dispersion") t.segmentation = SegmentationMode::kDispersion;
+    else ok = false;
+  } else if (key == "period_travel_m") ok = real(&t.period_travel_m);
+  else if (key == "period_time_s") ok = real(&t.period_time_s);
+  else if (key == "period_scans") ok = integer(&t.period_scans);
+  else if (key == "dispersion_threshold_m") ok = real(&t.dispersion_threshold_m);
+  else if (key == "min_segment_scans") ok = integer(&t.min_segment_scans);
+  else if (key == "max_segment_scans") ok = integer(&t.max_segment_scans);
+  else if (key == "max_levels") ok = integer(&t.max_levels);
+  else if (key == "accumulation") {
+    if (v == "sum") t.accumulation = PgsAccumulation::kSum;
+    else if (v == "mean") t.accumulation = PgsAccumulation::kMean;
+    else ok = false;
+  } else if (key == "prior_error_m") ok = real(&t.prior_error_m);
+  else if (key == "max_permanent_submaps") ok = integer(&t.max_permanent_submaps);
+  else if (key == "skeleton_points") ok = integer(&t.skeleton_points);
+  else if (key == "skeleton_downsample") ok = integer(&t.skeleton_downsample);
+  else if (key == "skeleton_pad_m") ok = real(&t.skeleton_pad_m);
+  else if (key == "skeleton_max_side_m") ok = real(&t.skeleton_max_side_m);
+  else if (key == "skeleton_min_clearance_m") ok = real(&t.skeleton_min_clearance_m);
+  else if (key == "occupied_threshold") ok = real(&t.occupied_threshold);
+  else if (key == "free_threshold") ok = real(&t.free_threshold);
+  else if (key == "work_cells_per_scan") ok = integer(&t.work_cells_per_scan);
+  else if (key == "icp_max_iterations") ok = integer(&t.icp.max_iterations);
+  else if (key == "icp_max_correspondence_m") ok = real(&t.icp.max_correspondence_m);
+  else if (key == "icp_nn_cell_m") ok = real(&t.icp.nn_cell_m);
+  else if (key == "icp_min_pairs") ok = integer(&t.icp.min_pairs);
+  else return SdpKeyResult::kUnknown;
+  if (!ok) {
+    if (why != nullptr) *why = "[sdp] " + key + ": malformed value '" + v + "'";
+    return SdpKeyResult::kInvalid;
+  }
+  char buf[200];
+  if (!t.validate(buf, sizeof buf)) {
+    if (why != nullptr) *why = buf;
+    return SdpKeyResult::kInvalid;
+  }
+  *o = t;
+  return SdpKeyResult::kApplied;
+}
+
+bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error) {
+  FILE* f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  IniState st{options, {}};
+  const int rc = ini_parse_file(f, sdp_handler, &st);
+  std::fclose(f);
+  if (rc != 0) {
+    *error = path + ":" + std::to_string(rc) + ": " + (st.why.empty() ? std::string("malformed line") : st.why);
+    return false;
+  }
+  return true;
+}
+
+SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
+                             SdpRunSummary* summary, std::string* error) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const DpSlamOptions& fo = options.config.filter;
+  char why[200];
+  if (!fo.validate(why, sizeof why) || !options.sdp.validate(why, sizeof why)) {
+    *error = std::string("invalid options: ") + why;
+    return SdpRunStatus::kBadInput;
+  }
+  io::LogReader reader;
+  if (!reader.open(log_path, options.config.log, error)) return SdpRunStatus::kBadInput;
+  if (!io::make_directories(out_dir, error)) return SdpRunStatus::kIoError;
+
+  // The whole state: one arena sized at init (the fixed memory budget).
+  const std::size_t arena_bytes = SdpSlam::required_arena_bytes(fo, options.sdp);
+  if (arena_bytes == 0U) {
+    *error = "invalid options (arena size)";
+    return SdpRunStatus::kBadInput;
+  }
+  std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
+  Arena arena(buffer.get(), arena_bytes);
+  auto slam = std::make_unique<SdpSlam>();
+  if (!slam->init(fo, options.sdp, arena, options.seed)) {
+    *error = std::string("SDP-SLAM init failed: ") + slam->why();
+    return SdpRunStatus::kInternal;
+  }
+  CollectSink permanent;
+  Rows rows;
+  slam->set_permanent_sink(&permanent);
+  slam->set_listener(&rows);
+
+  std::vector<ScanLog> scans;
+  std::vector<double> scan_ms;
+  std::vector<double> segment_ms;
+  Pose2 last_odom;
+  bool have_odom = false;
+  std::uint64_t scans_without_odom = 0U;
+  for (;;) {
+    const io::LogReader::Next k = reader.next();
+    if (k == io::LogReader::Next::kEnd) break;
+    if (k == io::LogReader::Next::kOdom) {
+      last_odom = reader.odom().pose;
+      have_odom = true;
+      continue;
+    }
+    if (k != io::LogReader::Next::kLaser) continue;
+    const io::LaserRecord& rec = reader.laser();
+    OdometrySample od;
+    od.stamp_us = rec.stamp_us;
+    if (rec.has_odom_pose) {
+      od.pose = rec.odom_pose;
+    } else if (have_odom) {
+      od.pose = last_odom;
+    } else {
+      ++scans_without_odom;
+      continue;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const SdpStepResult r = slam->process(od, rec.scan);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    scan_ms.push_back(ms);
+    if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
+    scans.push_back(ScanLog{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
+    if (options.progress && scans.size() % 200U == 0U) {
+      std::fprintf(stderr, "\rscans %zu processed %llu segments %llu", scans.size(),
+                   static_cast<unsigned long long>(slam->bottom().stats().processed),
+                   static_cast<unsigned long long>(slam->stats().segments));
+    }
+  }
+  if (options.progress) std::fprintf(stderr, "\n");
+  if (scans.empty()) {
+    *error = log_path + ": no laser scan with odometry in the log";
+    return SdpRunStatus::kBadInput;
+  }
+  slam->finish();
+
+  // The best combination's path: permanent segments, then the live chain.
+  std::vector<io::StampedPose> path = permanent.poses;
+  slam->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
+  std::vector<io::StampedPose> trajectory;
+  trajectory.reserve(scans.size());
+  std::size_t pi = 0U;
+  bool anchored = false;
+  Pose2 anchor_pose;
+  Pose2 anchor_odom;
+  std::uint64_t path_gaps = 0U;
+  for (const ScanLog& s : scans) {
+    Pose2 pose;
+    bool from_path = false;
+    if (s.processed) {
+      while (pi < path.size() && path[pi].stamp_us < s.stamp_us) ++pi;
+      if (pi < path.size() && path[pi].stamp_us == s.stamp_us) {
+        pose = path[pi].pose;
+        ++pi;
+        from_path = true;
+      } else {
+        ++path_gaps;
+      }
+    }
+    if (!from_path) pose = anchored ? anchor_pose.compose(between(anchor_odom, s.odom)) : s.online;
+    if (from_path || !anchored) {
+      anchor_pose = pose;
+      anchor_odom = s.odom;
+      anchored = true;
+    }
+    trajectory.push_back({s.stamp_us, pose});
+  }
+
+  io::OccupancyImage image;
+  const std::uint32_t known_cells = global_map_image(*slam, &image);
+  if (!io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error)) return SdpRunStatus::kIoError;
+  if (image.width > 0U) {
+    if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return SdpRunStatus::kIoError;
+    if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return SdpRunStatus::kIoError;
+  }
+  std::string csv = "stamp_s,mean_m,std_m,samples\n";
+  for (const Row& r : rows.rows) {
+    char line[128];
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%u\n", io::format_stamp_us(r.stamp_us).c_str(), r.mean_m, r.std_m,
+                  r.samples);
+    csv += line;
+  }
+  if (!io::write_file_atomic(out_dir + "/icp_error.csv", csv, error)) return SdpRunStatus::kIoError;
+  if (!write_error_plot(out_dir + "/icp_error.png", rows.rows, scans.front().stamp_us, scans.back().stamp_us, error)) {
+    return SdpRunStatus::kIoError;
+  }
+
+  // stats.json
+  const DpSlamFilter& bottom = slam->bottom();
+  const AncestryTree& tree = bottom.tree();
+  const DpMap& map = bottom.map();
+  const DpSlamStats& bs = bottom.stats();
+  const SdpStats& st = slam->stats();
+  const SegmentGraph& g = slam->graph();
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  auto u = [](std::uint64_t v) { return std::to_string(v); };
+  const SdpOptions& so = options.sdp;
+  std::string js = "{\n";
+  js += "  \"log\": \"" + log_path + "\",\n";
+  js += "  \"mode\": \"sdp\",\n  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
+        "\",\n";
+  js += "  \"top_particles\": " + u(so.top_particles) + ",\n  \"bottom_particles\": " + u(fo.particle_count) +
+        ",\n  \"seed\": " + u(options.seed) + ",\n";
+  js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(bs.processed) + ",\n";
+  js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
+  js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
+  js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
+  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
+        u(st.submaps_released) + ",\n";
+  js += "  \"icp_error\": {\"mean_m\": " + fmt("%.6f", st.error_mean_m()) + ", \"std_m\": " +
+        fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
+        ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
+        ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
+  js += "  \"pools\": {\n";
+  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
+        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(bs.node_fallback_count) + "},\n";
+  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
+        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
+  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
+        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
+  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
+        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +
+        ", \"refused\": " + u(st.pgs_refused) + "},\n";
+  js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +
+        u(slam->permanent_submap_count()) + ", \"forgotten\": " + u(st.permanent_forgotten) + "},\n";
+  js += "    \"pose_ring\": {\"capacity\": " + u(slam->pose_ring_capacity()) + ", \"peak\": " + u(st.pose_ring_peak) +
+        ", \"dropped\": " + u(st.pose_ring_dropped) + "},\n";
+  js += "    \"map_updates_dropped\": " + u(bs.map_updates_dropped) + ",\n";
+  js += "    \"global_map_updates_dropped\": " + u(st.map_transfer_dropped) + ",\n";
+  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
+  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
+  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"arena_used_bytes\": " + u(arena.used_bytes()) +
+        ", \"global_map_known_cells\": " + u(known_cells) + "},\n";
+  js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
+        fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
+        ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"segmentation_scan_ms_max\": " +
+        fmt("%.3f", percentile(segment_ms, 1.0)) + ", \"peak_rss_kib\": " +
+        u(static_cast<std::uint64_t>(ru.ru_maxrss)) + "}\n}\n";
+  if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return SdpRunStatus::kIoError;
+
+  if (summary != nullptr) {
+    summary->scans = scans.size();
+    summary->processed = bs.processed;
+    summary->segments = st.segments;
+    summary->log_error_count = reader.error_count();
+    summary->wall_time_s = wall_s;
+    summary->icp_error_mean_m = st.error_mean_m();
+    summary->icp_error_std_m = st.error_std_m();
+    summary->icp_error_samples = st.error_samples;
+  }
+  return SdpRunStatus::kOk;
+}
+
+}  // namespace sdpslam::slam
