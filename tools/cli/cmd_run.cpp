@@ -1,6 +1,5 @@
 // `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
-//               [--topology sdp|segslam] [--config FILE.ini] [--sdp-config FILE.ini]
-//               [--seed S] --out DIR`
+//               [--topology sdp|segslam] [--config FILE.ini] [--seed S] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
 // (tools/slam/run_sdp.h); dpslam: the bottom-level DP-SLAM filter alone, the baseline
 // (tools/slam/run_offline.h).
@@ -22,7 +21,6 @@ struct RunArgs {
   std::uint32_t top_particles = 0U;  // 0 = from the sdp config (60)
   std::string topology;
   std::string config;
-  std::string sdp_config;
   std::uint64_t seed = 1U;
   std::string out;
 };
@@ -38,7 +36,7 @@ int run_sdp_mode(const RunArgs& a, slam::SlamConfig config) {
   slam::SdpRunOptions ro;
   ro.config = config;
   std::string error;
-  if (!a.sdp_config.empty() && !slam::load_sdp_ini(a.sdp_config, &ro.sdp, &error)) {
+  if (!a.config.empty() && !slam::load_sdp_ini(a.config, &ro.sdp, &error)) {
     return report("", kExitBadInput, error);
   }
   ro.config.filter.particle_count = a.particles != 0U ? a.particles : kSdpDefaultBottomParticles;
@@ -105,8 +103,7 @@ std::function<int()> setup_run(CLI::App& app) {
   app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)");
   app.add_option("--topology", args->topology, "sdp: topology estimation, sdp (default) or segslam (local analysis)")
       ->check(CLI::IsMember({"sdp", "segslam"}));
-  app.add_option("--config", args->config, "INI options of the bottom level (see tools/slam/default.ini)");
-  app.add_option("--sdp-config", args->sdp_config, "sdp: INI file with an [sdp] section (see tools/slam/sdp.ini)");
+  app.add_option("--config", args->config, "INI options: bottom level and [sdp] (see tools/slam/default.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)");
   app.add_option("--out", args->out, "Output directory")->required();
   return [args]() -> int {

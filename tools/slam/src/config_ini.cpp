@@ -111,6 +111,8 @@ int handler(void* user, const char* section, const char* name, const char* value
   auto* st = static_cast<ParseState*>(user);
   const int lineno = st->line;
   if (name == nullptr) return 1;  // section header alone
+  // [sdp] belongs to the SDP-SLAM top level; its keys are read by load_sdp_ini (run_sdp.h).
+  if (std::strcmp(section, "sdp") == 0) return 1;
   std::string why;
   const ConfigKeyResult r = apply_config_key(st->config, section, name, value, &why);
   if (r == ConfigKeyResult::kApplied) return 1;

@@ -17,7 +17,8 @@ struct SlamConfig {
 // Applies the keys of `path` on top of *config (keys not in the file keep their value).
 // False iff the file cannot be read, a line is malformed, a section/key is unknown, a
 // value is not a finite number of the right kind, or a value makes the options invalid;
-// `error` is then "file:line: reason".
+// `error` is then "file:line: reason". An [sdp] section (SDP-SLAM's top level, read by
+// load_sdp_ini in run_sdp.h) is skipped.
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
 
 // One `key = value` of the sections above ([filter] [motion] [observation] [map]
