@@ -7,6 +7,12 @@ add_library(sdpslam_core_warnings INTERFACE)
 target_link_libraries(sdpslam_core_warnings INTERFACE sdpslam_warnings)
 target_compile_options(sdpslam_core_warnings INTERFACE -Wconversion -Wsign-conversion -Wdouble-promotion)
 
+# Bit-identical results on every architecture: no fused multiply-add contraction. GCC
+# contracts a*b+c into one FMA instruction by default in C++ even with -std=c++17 (its
+# ISO-mode exception is for C only), and aarch64 always has FMA, so without this the
+# arm64 packages compute different last bits than amd64.
+add_compile_options(-ffp-contract=off)
+
 if(SDPSLAM_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)

@@ -5,7 +5,7 @@
 # here gives one place that says what ships.
 #
 # Two components, one Debian package each:
-#   runtime -> `sdpslam`        sdpslamd, its systemd unit, /etc/sdpslam/sdpslamd.ini
+#   runtime -> `sdpslam`        sdpslamd, its systemd unit, /etc/sdpslamd/sdpslamd.ini
 #                               (conffile), sysusers/tmpfiles snippets, the `sdpslam` tools
 #   dev     -> `libsdpslam-dev` headers, static libraries, CMake package (sdpslam::core, ...)
 #
@@ -15,8 +15,11 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(SDPSLAM_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/sdpslam" CACHE STRING
-  "Where the CMake package files go, relative to the prefix")
+# Where the CMake package goes (relative to the prefix); follows CMAKE_INSTALL_LIBDIR
+# (lib/<triplet> in the packages) unless set on the command line.
+if(NOT DEFINED SDPSLAM_INSTALL_CMAKEDIR)
+  set(SDPSLAM_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/sdpslam")
+endif()
 
 # ---- libraries, headers, CMake package (component dev) --------------------------------
 # target -> name under sdpslam:: ; only what this build has (drivers and io are optional).
@@ -35,6 +38,10 @@ foreach(pair IN LISTS _sdpslam_exports)
     list(APPEND _sdpslam_export_targets ${target})
   endif()
 endforeach()
+# The core's headers hold inline arithmetic (Pose2, det_math): users compile it without
+# FMA contraction too, so their results match the library's on every architecture.
+set_property(TARGET sdpslam_core APPEND PROPERTY INTERFACE_COMPILE_OPTIONS
+  "$<INSTALL_INTERFACE:-ffp-contract=off>")
 set(SDPSLAM_EXPORTS_IO OFF)
 if(TARGET sdpslam_io)
   set(SDPSLAM_EXPORTS_IO ON)
@@ -69,9 +76,9 @@ install(FILES "${PROJECT_BINARY_DIR}/sdpslamConfig.cmake" "${PROJECT_BINARY_DIR}
 # prefix the configuration stays inside it so `cmake --install --prefix DIR` never writes
 # outside DIR.
 if(IS_ABSOLUTE "${CMAKE_INSTALL_FULL_SYSCONFDIR}" AND NOT CMAKE_INSTALL_FULL_SYSCONFDIR MATCHES "^${CMAKE_INSTALL_PREFIX}/")
-  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_FULL_SYSCONFDIR}/sdpslam")
+  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_FULL_SYSCONFDIR}/sdpslamd")
 else()
-  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_SYSCONFDIR}/sdpslam")
+  set(SDPSLAM_INSTALL_CONFDIR "${CMAKE_INSTALL_SYSCONFDIR}/sdpslamd")
 endif()
 # systemd's own folders under the prefix (/usr/lib/... on a merged-/usr Debian).
 set(SDPSLAM_INSTALL_SYSTEMDDIR "lib/systemd/system")
@@ -82,6 +89,8 @@ endif()
 set(_sdpslam_conffiles "")
 set(_sdpslam_has_daemon OFF)
 if(TARGET sdpslamd)
+  # Paths follow the unit (firmware-host/systemd/sdpslamd.service): ConfigurationDirectory=
+  # sdpslamd, i.e. /etc/sdpslamd/sdpslamd.ini, a conffile so dpkg keeps local edits.
   set(_sdpslam_has_daemon ON)
   set(_fw "${PROJECT_SOURCE_DIR}/firmware-host")
   install(TARGETS sdpslamd RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
@@ -91,16 +100,21 @@ if(TARGET sdpslamd)
   endif()
   if(EXISTS "${_fw}/sdpslamd.ini")
     install(FILES "${_fw}/sdpslamd.ini" DESTINATION ${SDPSLAM_INSTALL_CONFDIR} COMPONENT runtime)
+    # The unit's Documentation= points at this copy, which stays pristine.
+    install(FILES "${_fw}/sdpslamd.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
     if(IS_ABSOLUTE "${SDPSLAM_INSTALL_CONFDIR}")
       list(APPEND _sdpslam_conffiles "${SDPSLAM_INSTALL_CONFDIR}/sdpslamd.ini")
     else()
       list(APPEND _sdpslam_conffiles "${CMAKE_INSTALL_PREFIX}/${SDPSLAM_INSTALL_CONFDIR}/sdpslamd.ini")
     endif()
   endif()
-  install(FILES "${CMAKE_CURRENT_LIST_DIR}/debian/sdpslam.sysusers"
-    DESTINATION lib/sysusers.d RENAME sdpslam.conf COMPONENT runtime)
-  install(FILES "${CMAKE_CURRENT_LIST_DIR}/debian/sdpslam.tmpfiles"
-    DESTINATION lib/tmpfiles.d RENAME sdpslam.conf COMPONENT runtime)
+  # The service user and the state folder (applied by the postinst, see cmake/debian/).
+  foreach(kind sysusers tmpfiles)
+    if(EXISTS "${_fw}/systemd/sdpslamd.${kind}.conf")
+      install(FILES "${_fw}/systemd/sdpslamd.${kind}.conf" DESTINATION lib/${kind}.d
+        RENAME sdpslamd.conf COMPONENT runtime)
+    endif()
+  endforeach()
 endif()
 # The offline runner's documented defaults, as an example for `sdpslam run --config`.
 if(TARGET sdpslam AND EXISTS "${PROJECT_SOURCE_DIR}/tools/slam/default.ini")
@@ -145,12 +159,17 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME sdpslam)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION science)
-set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
-  "Segmented DP-SLAM onboard program and tools\n sdpslamd builds a map and the robot's trajectory on the robot's computer from\n wheel encoders (SocketCAN) and a laser rangefinder (serial), in fixed memory.\n The sdpslam command simulates, converts logs, runs SLAM offline and evaluates.\n The systemd unit is installed but not enabled.")
+# First line: the synopsis; the rest: the long description (CPack indents it).
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "Segmented DP-SLAM onboard program and tools
+sdpslamd builds a map and the robot's trajectory on the robot's computer from wheel
+encoders (SocketCAN) and a laser rangefinder (serial port), in fixed memory. The sdpslam
+command simulates, converts logs, runs SLAM offline and evaluates. The systemd unit
+sdpslamd.service is installed but not enabled.")
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libsdpslam-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
-set(CPACK_COMPONENT_DEV_DESCRIPTION
-  "Segmented DP-SLAM library: headers, static libraries, CMake package\n find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal,\n sdpslam::drivers and sdpslam::io.")
+set(CPACK_DEBIAN_DEV_DESCRIPTION "Segmented DP-SLAM library: headers, static libraries, CMake package
+find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal, sdpslam::drivers
+and sdpslam::io. The libraries are static: the core is linked into the robot's firmware.")
 # The CMake package finds these (sdpslamConfig.cmake).
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3)")
 if(SDPSLAM_EXPORTS_IO)
