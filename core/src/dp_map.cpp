@@ -36,6 +36,9 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   return static_cast<std::uint64_t>(d->tiles_x) * d->tiles_y < 0xFFFFFFFFULL;
 }
 
+// owner → node, node → owner, owner list head, owner count, free-owner stack.
+constexpr std::size_t kOwnerTables = 5U;
+
 template <typename T>
 std::size_t pool_bytes(std::uint32_t capacity) {
   return PoolOf<T>::kSlotSize * capacity + 2U * sizeof(std::uint32_t) * capacity + alignof(T) +
@@ -52,7 +55,7 @@ bool DpMap::options_valid(const Options& options) {
 std::size_t DpMap::required_arena_bytes(const Options& options, std::uint32_t node_capacity) {
   GridDims d;
   if (!grid_dims(options, &d)) return 0U;
-  return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + node_capacity) +
+  return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + kOwnerTables * node_capacity) +
          2U * alignof(std::uint32_t) + pool_bytes<Tile>(options.tile_capacity) +
          pool_bytes<Observation>(options.observation_capacity);
 }
@@ -63,13 +66,27 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   if (!grid_dims(options, &d) || tree.capacity() == 0U) return false;
   const std::size_t table_entries = static_cast<std::size_t>(d.tiles_x) * d.tiles_y;
   tile_table_ = arena.allocate_array<std::uint32_t>(table_entries);
-  node_head_ = arena.allocate_array<std::uint32_t>(tree.capacity());
-  if (tile_table_ == nullptr || node_head_ == nullptr) return false;
+  const std::size_t cap = tree.capacity();
+  std::uint32_t* owners = arena.allocate_array<std::uint32_t>(kOwnerTables * cap);
+  if (tile_table_ == nullptr || owners == nullptr) return false;
+  owner_node_ = owners;
+  node_owner_ = owners + cap;
+  owner_head_ = owners + 2U * cap;
+  owner_count_ = owners + 3U * cap;
+  owner_free_ = owners + 4U * cap;
   if (!tiles_pool_.init(arena, options.tile_capacity) || !obs_pool_.init(arena, options.observation_capacity)) {
     return false;
   }
   for (std::size_t i = 0; i < table_entries; ++i) tile_table_[i] = kNone;
-  for (std::uint32_t i = 0; i < tree.capacity(); ++i) node_head_[i] = kNone;
+  // Free stack popped from the top: owner 0 is handed out first.
+  for (std::uint32_t i = 0; i < tree.capacity(); ++i) {
+    owner_node_[i] = kNoNode;
+    node_owner_[i] = kNone;
+    owner_head_[i] = kNone;
+    owner_count_[i] = 0U;
+    owner_free_[i] = tree.capacity() - 1U - i;
+  }
+  owner_free_count_ = tree.capacity();
   options_ = options;
   width_cells_ = d.width_cells;
   height_cells_ = d.height_cells;
@@ -100,11 +117,19 @@ void DpMap::cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y
   *y_m = options_.origin_y_m + (static_cast<double>(iy) + 0.5) * options_.resolution_m;
 }
 
-std::uint32_t DpMap::find_in_cell(std::uint32_t first, NodeId node) const {
+std::uint32_t DpMap::find_in_cell(std::uint32_t first, std::uint32_t owner) const {
   for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
-    if (obs_[e].node == node) return e;
+    if (obs_[e].owner == owner) return e;
   }
   return kNone;
+}
+
+void DpMap::release_owner(std::uint32_t owner) {
+  node_owner_[owner_node_[owner]] = kNone;
+  owner_node_[owner] = kNoNode;
+  owner_head_[owner] = kNone;
+  owner_count_[owner] = 0U;
+  owner_free_[owner_free_count_++] = owner;
 }
 
 bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation value) {
@@ -119,8 +144,9 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   const std::uint32_t ti = tile_index(ix, iy);
   const std::uint32_t c = cell_in_tile(ix, iy);
   std::uint32_t slot = tile_table_[ti];
-  if (slot != kNone) {
-    const std::uint32_t e = find_in_cell(tiles_[slot].head[c], particle);
+  std::uint32_t owner = node_owner_[particle];
+  if (slot != kNone && owner != kNone) {
+    const std::uint32_t e = find_in_cell(tiles_[slot].head[c], owner);
     if (e != kNone) {
       obs_[e].value = value;
       return true;
@@ -156,11 +182,17 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
       if (ty > touched_ty1_) touched_ty1_ = ty;
     }
   }
+  if (owner == kNone) {
+    // Cannot be empty: owners in use belong to distinct live nodes, `particle` has none.
+    owner = owner_free_[--owner_free_count_];
+    owner_node_[owner] = particle;
+    node_owner_[particle] = owner;
+  }
   Observation* o = static_cast<Observation*>(obs_pool_.allocate());  // cannot fail: checked above
   const std::uint32_t e = obs_pool_.index_of(o);
   obs_ = o - e;
   Tile& tile = tiles_[slot];
-  o->node = particle;
+  o->owner = owner;
   o->value = value;
   o->location = (slot << (2U * kSideLog2)) | c;
   // Keep descendants before ancestors: a leaf goes first; an inner node goes after the
@@ -168,13 +200,14 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   std::uint32_t* link = &tile.head[c];
   if (tree_->child_count(particle) > 0U) {
     for (std::uint32_t* l = link; *l != kNone; l = &obs_[*l].next_in_cell) {
-      if (tree_->is_ancestor_or_self(particle, obs_[*l].node)) link = &obs_[*l].next_in_cell;
+      if (tree_->is_ancestor_or_self(particle, owner_node_[obs_[*l].owner])) link = &obs_[*l].next_in_cell;
     }
   }
   o->next_in_cell = *link;
   *link = e;
-  o->next_in_node = node_head_[particle];
-  node_head_[particle] = e;
+  o->next_in_node = owner_head_[owner];
+  owner_head_[owner] = e;
+  ++owner_count_[owner];
   ++tile.count;
   return true;
 }
@@ -209,49 +242,79 @@ void DpMap::remove_node(NodeId node) {
     ++misuse_count_;
     return;
   }
-  std::uint32_t e = node_head_[node];
+  const std::uint32_t owner = node_owner_[node];
+  if (owner == kNone) return;
+  std::uint32_t e = owner_head_[owner];
   while (e != kNone) {
     const std::uint32_t next = obs_[e].next_in_node;
     release_observation(e);
     e = next;
   }
-  node_head_[node] = kNone;
+  release_owner(owner);
 }
 
+// Parent P merges into its only child C (§II-A). C's entries are newer than P's and, in
+// every cell list, ahead of them (a node's entries precede its ancestors'). Whichever
+// side owns fewer observations is moved into the other's owner, which then belongs to C.
+// The cell order invariant holds afterwards: an entry keeps its place in its cell list,
+// and both P's and C's places lie after every entry of C's descendants (P's descendants
+// are C and C's descendants) and before every entry of P's ancestors (C's ancestors now).
 void DpMap::merge_node(NodeId parent, NodeId child) {
   if (tree_ == nullptr || parent >= node_capacity_ || child >= node_capacity_ || parent == child) {
     ++misuse_count_;
     return;
   }
-  std::uint32_t e = node_head_[parent];
-  if (node_head_[child] == kNone) {
-    // Common case (the child is a fresh particle): nothing to shadow, relabel only.
-    if (e == kNone) return;
-    std::uint32_t last = e;
-    for (std::uint32_t x = e; x != kNone; x = obs_[x].next_in_node) {
-      obs_[x].node = child;
-      last = x;
+  const std::uint32_t op = node_owner_[parent];
+  const std::uint32_t oc = node_owner_[child];
+  if (op == kNone) return;  // nothing to hand down
+  if (oc == kNone || owner_count_[op] > owner_count_[oc]) {
+    // The child's side is smaller: fold it into the parent's owner, then hand that owner
+    // to the child. A fresh particle (no observations) makes this O(1).
+    if (oc != kNone) {
+      std::uint32_t e = owner_head_[oc];
+      while (e != kNone) {
+        Observation& o = obs_[e];
+        const std::uint32_t next = o.next_in_node;
+        // P's entry in this cell, if any, follows C's.
+        const std::uint32_t f = find_in_cell(o.next_in_cell, op);
+        if (f != kNone) {
+          obs_[f].value = o.value;  // C's record is newer: it survives in P's slot
+          release_observation(e);   // the tile keeps f, so it stays
+        } else {
+          o.owner = op;
+          o.next_in_node = owner_head_[op];
+          owner_head_[op] = e;
+          ++owner_count_[op];
+        }
+        e = next;
+      }
+      owner_head_[oc] = kNone;
+      release_owner(oc);
     }
-    node_head_[child] = e;
-    obs_[last].next_in_node = kNone;
-    node_head_[parent] = kNone;
+    node_owner_[parent] = kNone;
+    owner_node_[op] = child;
+    node_owner_[child] = op;
     return;
   }
+  // The parent's side is not larger: move it into the child's owner.
+  std::uint32_t e = owner_head_[op];
   while (e != kNone) {
     Observation& o = obs_[e];
     const std::uint32_t next = o.next_in_node;
     const std::uint32_t loc = o.location;
     const std::uint32_t head = tiles_[loc >> (2U * kSideLog2)].head[loc & (capacity::kDpTileCells - 1U)];
-    if (find_in_cell(head, child) != kNone) {
+    if (find_in_cell(head, oc) != kNone) {
       release_observation(e);  // the child's own record is newer and shadows it
     } else {
-      o.node = child;
-      o.next_in_node = node_head_[child];
-      node_head_[child] = e;
+      o.owner = oc;
+      o.next_in_node = owner_head_[oc];
+      owner_head_[oc] = e;
+      ++owner_count_[oc];
     }
     e = next;
   }
-  node_head_[parent] = kNone;
+  owner_head_[op] = kNone;
+  release_owner(op);
 }
 
 void DpMap::location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const {
@@ -306,13 +369,12 @@ std::uint32_t DpMap::entries_in_cell(std::int32_t ix, std::int32_t iy) const {
 
 std::uint32_t DpMap::observation_count(NodeId node) const {
   if (tree_ == nullptr || node >= node_capacity_) return 0U;
-  std::uint32_t n = 0U;
-  for (std::uint32_t e = node_head_[node]; e != kNone; e = obs_[e].next_in_node) ++n;
-  return n;
+  const std::uint32_t owner = node_owner_[node];
+  return owner == kNone ? 0U : owner_count_[owner];
 }
 
 std::size_t DpMap::footprint_bytes() const {
-  return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + node_capacity_) +
+  return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + kOwnerTables * node_capacity_) +
          tiles_pool_.footprint_bytes() + obs_pool_.footprint_bytes();
 }
 
@@ -338,23 +400,51 @@ bool DpMap::invariants_hold() const {
         if (!obs_pool_.slot_in_use(e) || ++in_cells > obs_total) return false;
         ++in_tile;
         const Observation& o = obs_[e];
-        if (o.location != ((slot << (2U * kSideLog2)) | c) || !tree_->contains(o.node)) return false;
+        if (o.location != ((slot << (2U * kSideLog2)) | c) || o.owner >= node_capacity_) return false;
+        const NodeId node = owner_node_[o.owner];
+        if (!tree_->contains(node)) return false;
         for (std::uint32_t f = o.next_in_cell; f != kNone; f = obs_[f].next_in_cell) {
-          if (obs_[f].node == o.node) return false;
-          if (tree_->is_ancestor_or_self(o.node, obs_[f].node)) return false;  // order
+          if (obs_[f].owner == o.owner) return false;
+          if (tree_->is_ancestor_or_self(node, owner_node_[obs_[f].owner])) return false;  // order
         }
       }
     }
     if (in_tile != tile.count) return false;
   }
   if (tiles_seen != tiles_pool_.size() || in_cells != obs_total) return false;
-  // Nodes: each list holds only that node's entries; lists add up to the pool count.
-  std::uint32_t in_nodes = 0U;
-  for (NodeId n = 0U; n < node_capacity_; ++n) {
-    if (node_head_[n] != kNone && !tree_->contains(n)) return false;
-    for (std::uint32_t e = node_head_[n]; e != kNone; e = obs_[e].next_in_node) {
-      if (!obs_pool_.slot_in_use(e) || ++in_nodes > obs_total || obs_[e].node != n) return false;
+  // Owners: the free stack holds distinct owners not in use; an owner in use (not on
+  // the stack) belongs to a live node that points back at it, has a non-empty list of
+  // its own entries whose length is its count; lists add up to the pool count.
+  if (owner_free_count_ > node_capacity_) return false;
+  for (std::uint32_t o = 0U; o < node_capacity_; ++o) {
+    if (owner_head_[o] == kNone && owner_node_[o] != kNoNode) return false;
+  }
+  std::uint32_t free_seen = 0U;
+  for (std::uint32_t i = 0U; i < owner_free_count_; ++i) {
+    const std::uint32_t o = owner_free_[i];
+    if (o >= node_capacity_ || owner_node_[o] != kNoNode || owner_head_[o] != kNone || owner_count_[o] != 0U) {
+      return false;
     }
+    ++free_seen;
+  }
+  std::uint32_t in_nodes = 0U;
+  std::uint32_t owners_in_use = 0U;
+  for (std::uint32_t o = 0U; o < node_capacity_; ++o) {
+    if (owner_node_[o] == kNoNode) continue;
+    ++owners_in_use;
+    const NodeId n = owner_node_[o];
+    if (n >= node_capacity_ || !tree_->contains(n) || node_owner_[n] != o) return false;
+    std::uint32_t len = 0U;
+    for (std::uint32_t e = owner_head_[o]; e != kNone; e = obs_[e].next_in_node) {
+      if (!obs_pool_.slot_in_use(e) || ++in_nodes > obs_total || obs_[e].owner != o) return false;
+      ++len;
+    }
+    if (len == 0U || len != owner_count_[o]) return false;
+  }
+  if (owners_in_use + free_seen != node_capacity_) return false;
+  for (NodeId n = 0U; n < node_capacity_; ++n) {
+    const std::uint32_t o = node_owner_[n];
+    if (o != kNone && (o >= node_capacity_ || owner_node_[o] != n)) return false;
   }
   return in_nodes == obs_total;
 }

@@ -186,6 +186,114 @@ TEST(DpMap, merge_relabels_to_the_child_except_where_the_child_is_newer) {
   CHECK_FALSE(f.map.lookup(q, 1, 1, &v));
 }
 
+// A parent with more observations than its only child keeps its entries: the child's
+// are moved into them (the child's newer value wins where both have one) and the
+// result belongs to the child. Views, counts and the cell order must be as if the
+// parent's had been relabelled.
+TEST(DpMap, merge_into_a_smaller_child_moves_the_childs_side_and_keeps_its_values) {
+  DpFixture f(8U, 8U, small_options(4U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  const NodeId p = t.add_child(r);
+  const NodeId q = t.add_child(r);
+  CHECK_TRUE(f.map.update(r, 3, 3, obs(5, 5)));
+  for (std::int32_t i = 0; i < 4; ++i) CHECK_TRUE(f.map.update(p, i, 0, obs(1, static_cast<std::uint16_t>(i))));
+  const NodeId c = t.add_child(p);
+  CHECK_TRUE(f.map.update(c, 1, 0, obs(9, 9)));  // shadows p's
+  CHECK_TRUE(f.map.update(c, 3, 3, obs(7, 7)));  // shadows r's
+  LONGS_EQUAL(2, f.map.entries_in_cell(1, 0));
+  t.set_active(p, false);
+  t.prune(&f.map);
+  CHECK_TRUE(f.map.invariants_hold());
+  CHECK_FALSE(t.contains(p));
+  LONGS_EQUAL(0, f.map.observation_count(p));
+  LONGS_EQUAL(5, f.map.observation_count(c));
+  LONGS_EQUAL(6, f.map.observations_used());
+  LONGS_EQUAL(1, f.map.entries_in_cell(1, 0));
+  LONGS_EQUAL(2, f.map.entries_in_cell(3, 3));
+  CHECK_TRUE(view_is(f.map, c, 0, 0, obs(1, 0)));
+  CHECK_TRUE(view_is(f.map, c, 1, 0, obs(9, 9)));
+  CHECK_TRUE(view_is(f.map, c, 2, 0, obs(1, 2)));
+  CHECK_TRUE(view_is(f.map, c, 3, 3, obs(7, 7)));
+  CHECK_TRUE(view_is(f.map, q, 3, 3, obs(5, 5)));
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(q, 0, 0, &v));
+  // The merged node is an ancestor now: its descendants still shadow it, and a later
+  // write by it lands behind theirs (the order lookups rely on).
+  const NodeId d = t.add_child(c);
+  CHECK_TRUE(f.map.update(d, 2, 0, obs(4, 4)));
+  CHECK_TRUE(f.map.update(c, 2, 0, obs(6, 6)));
+  CHECK_TRUE(f.map.update(d, 5, 5, obs(4, 5)));
+  CHECK_TRUE(f.map.update(c, 5, 5, obs(8, 8)));  // a new entry of an inner node
+  CHECK_TRUE(f.map.invariants_hold());
+  CHECK_TRUE(view_is(f.map, d, 2, 0, obs(4, 4)));
+  CHECK_TRUE(view_is(f.map, c, 2, 0, obs(6, 6)));
+  CHECK_TRUE(view_is(f.map, d, 5, 5, obs(4, 5)));
+  CHECK_TRUE(view_is(f.map, c, 5, 5, obs(8, 8)));
+  CHECK_TRUE(view_is(f.map, d, 3, 3, obs(7, 7)));
+  LONGS_EQUAL(6, f.map.observation_count(c));
+  // Removing the merged node frees everything it owns, whichever side it came from.
+  t.set_active(c, false);
+  t.set_active(d, false);
+  t.set_active(q, false);
+  t.set_active(r, false);
+  t.prune(&f.map);
+  CHECK_TRUE(f.map.invariants_hold());
+  LONGS_EQUAL(0, f.map.observations_used());
+  LONGS_EQUAL(0, f.map.tiles_used());
+}
+
+TEST(DpMap, merge_into_a_larger_child_moves_the_parents_side) {
+  DpFixture f(8U, 8U, small_options(4U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  const NodeId p = t.add_child(r);
+  const NodeId q = t.add_child(r);
+  CHECK_TRUE(f.map.update(p, 0, 0, obs(1, 1)));
+  CHECK_TRUE(f.map.update(p, 20, 20, obs(2, 2)));  // a tile of its own
+  const NodeId c = t.add_child(p);
+  for (std::int32_t i = 0; i < 4; ++i) CHECK_TRUE(f.map.update(c, i, 1, obs(3, static_cast<std::uint16_t>(i))));
+  CHECK_TRUE(f.map.update(c, 0, 0, obs(9, 9)));
+  t.set_active(p, false);
+  t.prune(&f.map);
+  CHECK_TRUE(f.map.invariants_hold());
+  LONGS_EQUAL(6, f.map.observation_count(c));
+  LONGS_EQUAL(6, f.map.observations_used());
+  LONGS_EQUAL(2, f.map.tiles_used());
+  LONGS_EQUAL(1, f.map.entries_in_cell(0, 0));
+  CHECK_TRUE(view_is(f.map, c, 0, 0, obs(9, 9)));
+  CHECK_TRUE(view_is(f.map, c, 20, 20, obs(2, 2)));
+  CHECK_TRUE(view_is(f.map, c, 3, 1, obs(3, 3)));
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(q, 20, 20, &v));
+}
+
+// A single lineage that merges every generation (one fresh child per step, the filter's
+// common case) keeps exactly one owner's worth of entries: views stay exact and no
+// storage leaks however long the chain.
+TEST(DpMap, a_long_chain_of_merges_keeps_views_and_storage_exact) {
+  DpFixture f(6U, 8U, small_options(4U, 64U));
+  auto& t = f.tree;
+  NodeId cur = t.create_root();
+  for (std::uint16_t g = 0; g < 200U; ++g) {
+    const NodeId next = t.add_child(cur);
+    CHECK(next != kNoNode);
+    const std::int32_t ix = static_cast<std::int32_t>(g % 10U);
+    CHECK_TRUE(f.map.update(next, ix, 0, obs(g, 1)));
+    if (g % 3U == 0U) CHECK_TRUE(f.map.update(next, 30, 30, obs(g, 2)));
+    t.set_active(cur, false);
+    t.prune(&f.map);
+    CHECK_TRUE(f.map.invariants_hold());
+    cur = next;
+    const std::uint32_t distinct = (g + 1U < 10U ? g + 1U : 10U) + 1U;
+    LONGS_EQUAL(distinct, f.map.observations_used());
+    LONGS_EQUAL(distinct, f.map.observation_count(cur));
+    CHECK_TRUE(view_is(f.map, cur, ix, 0, obs(g, 1)));
+  }
+  CHECK_TRUE(view_is(f.map, cur, 30, 30, obs(198, 2)));
+  CHECK_TRUE(view_is(f.map, cur, 0, 0, obs(190, 1)));
+}
+
 TEST(DpMap, observation_exhaustion_is_counted_and_leaves_views_unchanged) {
   DpFixture f(8U, 8U, small_options(4U, 3U));
   auto& t = f.tree;

@@ -12,10 +12,20 @@
 //  - a tile index table, one u32 per tile of kDpTileSideCells² cells, covering the area;
 //  - tiles (cell list heads) from a pool, allocated on the first write into the tile and
 //    released when their last observation goes, so unexplored space costs 4 bytes/tile;
-//  - observations (20 bytes: node, cell link, node link, cell address, value) from a
-//    pool; each node keeps an intrusive list of the observations it owns, so the tree's
-//    prune/merge (TreeListener) costs O(observations of that node × cell list length);
-//  - a per-node list head table sized by the tree's capacity.
+//  - observations (20 bytes: owner, cell link, owner link, cell address, value) from a
+//    pool. An observation names an *owner* slot, not a node: owner → node and
+//    node → owner tables (one owner per node that has observations, sized by the tree's
+//    capacity) add one indirection to lookups and make a merge cost O(smaller side).
+//    Each owner keeps an intrusive list of its observations and their count;
+//  - owner tables: owner → node, node → owner, list head, count, free-owner stack.
+//
+// Merge cost (TreeListener::on_node_merged, parent P into its only child C): if P owns
+// more observations than C, C's are moved into P's owner (where both have one in a
+// cell, C's newer value is copied into P's entry and C's is freed) and P's owner is
+// re-pointed to C; otherwise P's are moved into C's owner. Either way
+// O(min(|P|, |C|) × cell list length): a fresh particle (C empty) costs O(1) however
+// long the history it inherits. Removal costs O(observations of the node × cell list
+// length).
 //
 // Ownership: the map keeps a reference to the AncestryTree given to init() (it must
 // outlive the map) and reads it for ancestor queries; the tree tells the map about
@@ -153,7 +163,7 @@ class DpMap final : public TreeListener {
   bool touched_bounds(CellRect* out) const;
   // Entries (of all nodes) in one cell's list; 0 outside the map. For diagnostics/tests.
   std::uint32_t entries_in_cell(std::int32_t ix, std::int32_t iy) const;
-  // Observations owned by `node`. O(that count).
+  // Observations owned by `node`. O(1).
   std::uint32_t observation_count(NodeId node) const;
 
   // ---- TreeListener (called by AncestryTree::prune) ----------------------------------
@@ -176,11 +186,14 @@ class DpMap final : public TreeListener {
   std::uint32_t observation_oom_count() const { return observation_oom_count_; }
   std::uint32_t out_of_bounds_count() const { return out_of_bounds_count_; }
   std::uint32_t misuse_count() const { return misuse_count_; }
-  // Bytes of state: tile table, tile pool, observation pool, node table.
+  // Bytes of state: tile table, tile pool, observation pool, owner tables.
   std::size_t footprint_bytes() const;
 
-  // Full self-check, O(capacity): pool invariants; every observation is in exactly one
-  // cell list and one node list, and they agree on its node and cell; no node has two
+  // Full self-check, O(capacity): pool invariants; the owner tables are a bijection
+  // between owners in use and the nodes that have observations, an owner is in use iff
+  // its list is non-empty, its count equals its list's length, and the free stack holds
+  // exactly the other owners; every observation is in exactly one cell list and one
+  // owner list, and they agree on its owner and cell; no node has two
   // observations in one cell and no entry follows an entry of one of its ancestors
   // (what lets lookups stop early); every node with observations is live in the tree; the
   // tile table and tile back-references agree; each tile's count equals its entries
@@ -193,7 +206,7 @@ class DpMap final : public TreeListener {
   static constexpr std::uint32_t kSideMask = capacity::kDpTileSideCells - 1U;
 
   struct Observation {
-    NodeId node;
+    std::uint32_t owner;  // owner slot; owner_node_[owner] is the node it belongs to
     std::uint32_t next_in_cell;
     std::uint32_t next_in_node;
     std::uint32_t location;  // (tile slot << 2k) | cell in tile
@@ -222,7 +235,8 @@ class DpMap final : public TreeListener {
     const AncestryTree::DescendantQuery query(*tree_, particle);
     for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
       const Observation& o = obs_[e];
-      if (o.node == particle || query.has_ancestor_or_self(o.node)) {
+      const NodeId node = owner_node_[o.owner];
+      if (node == particle || query.has_ancestor_or_self(node)) {
         *out = o.value;
         return true;
       }
@@ -233,7 +247,8 @@ class DpMap final : public TreeListener {
   void merge_node(NodeId parent, NodeId child);
   void unlink_from_cell(std::uint32_t e);
   void release_observation(std::uint32_t e);
-  std::uint32_t find_in_cell(std::uint32_t first, NodeId node) const;
+  std::uint32_t find_in_cell(std::uint32_t first, std::uint32_t owner) const;
+  void release_owner(std::uint32_t owner);
   void location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const;
 
   Options options_{};
@@ -247,7 +262,17 @@ class DpMap final : public TreeListener {
   Tile* tiles_ = nullptr;  // slot 0 of tiles_pool_ (slots are contiguous)
   ArenaPool<Observation> obs_pool_;
   Observation* obs_ = nullptr;  // slot 0 of obs_pool_
-  std::uint32_t* node_head_ = nullptr;  // per NodeId: first owned observation
+  // Owner tables, node_capacity_ entries each, one arena block. An owner is in use iff
+  // it is not on the free stack; then owner_node_[o] is its node,
+  // node_owner_[owner_node_[o]] == o, owner_head_[o] its first observation (never
+  // kNone) and owner_count_[o] ≥ 1 its list length. node_owner_[n] is kNone for a node
+  // without observations.
+  std::uint32_t* owner_node_ = nullptr;
+  std::uint32_t* node_owner_ = nullptr;
+  std::uint32_t* owner_head_ = nullptr;
+  std::uint32_t* owner_count_ = nullptr;
+  std::uint32_t* owner_free_ = nullptr;  // stack of free owners, owner_free_count_ deep
+  std::uint32_t owner_free_count_ = 0U;
   std::uint32_t node_capacity_ = 0U;
   std::uint32_t touched_tx0_ = kNone, touched_ty0_ = kNone, touched_tx1_ = 0U, touched_ty1_ = 0U;
   std::uint32_t tile_oom_count_ = 0U;
