@@ -143,8 +143,8 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   }
   const std::uint32_t ti = tile_index(ix, iy);
   const std::uint32_t c = cell_in_tile(ix, iy);
-  std::uint32_t slot = tile_table_[ti];
-  std::uint32_t owner = node_owner_[particle];
+  const std::uint32_t slot = tile_table_[ti];
+  const std::uint32_t owner = node_owner_[particle];
   if (slot != kNone && owner != kNone) {
     const std::uint32_t e = find_in_cell(tiles_[slot].head[c], owner);
     if (e != kNone) {
@@ -152,6 +152,12 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
       return true;
     }
   }
+  return insert(particle, ti, c, value);
+}
+
+bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObservation value) {
+  std::uint32_t slot = tile_table_[ti];
+  std::uint32_t owner = node_owner_[particle];
   // A new entry is needed. Check the observation pool first so that a refused update
   // never allocates (and then has to release) a tile.
   if (obs_pool_.full()) {
@@ -212,10 +218,38 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   return true;
 }
 
+// One scan instead of lookup() + update(): the first entry of `particle` or of an
+// ancestor is its view; if it is the particle's own, it is updated in place, otherwise
+// the particle has none in this cell (its own would come first) and a new one is made.
 bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
-  CellObservation view;
-  if (!lookup(particle, ix, iy, &view)) view = CellObservation{};
-  return update(particle, ix, iy, accumulate(view, hits, misses));
+  if (tree_ == nullptr || !tree_->contains(particle)) {
+    ++misuse_count_;
+    return false;
+  }
+  if (!in_bounds(ix, iy)) {
+    ++out_of_bounds_count_;
+    return false;
+  }
+  const std::uint32_t ti = tile_index(ix, iy);
+  const std::uint32_t c = cell_in_tile(ix, iy);
+  const std::uint32_t slot = tile_table_[ti];
+  CellObservation view{};
+  if (slot != kNone) {
+    const AncestryTree::DescendantQuery query(*tree_, particle);
+    for (std::uint32_t e = tiles_[slot].head[c]; e != kNone; e = obs_[e].next_in_cell) {
+      Observation& o = obs_[e];
+      const NodeId node = owner_node_[o.owner];
+      if (node == particle) {
+        o.value = accumulate(o.value, hits, misses);
+        return true;
+      }
+      if (query.has_ancestor_or_self(node)) {
+        view = o.value;
+        break;
+      }
+    }
+  }
+  return insert(particle, ti, c, accumulate(view, hits, misses));
 }
 
 void DpMap::unlink_from_cell(std::uint32_t e) {

@@ -144,7 +144,8 @@ class DpMap final : public TreeListener {
   // or `particle` is not a live tree node (misuse_count). O(cell list length).
   bool update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation value);
   // lookup() then accumulate() then update(): the particle's own record becomes its
-  // current view plus the new evidence. Same result and failure rules as update().
+  // current view plus the new evidence. Same result and failure rules as update(), in
+  // one scan of the cell list that stops at the first ancestor-or-self entry.
   bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
 
   // ---- extraction --------------------------------------------------------------------
@@ -243,6 +244,9 @@ class DpMap final : public TreeListener {
     }
     return false;
   }
+  // New entry of `particle` (live, no entry in this cell yet) in cell `c` of tile-table
+  // entry `ti`; the tail of update()/add() with their exhaustion rules.
+  bool insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObservation value);
   void remove_node(NodeId node);
   void merge_node(NodeId parent, NodeId child);
   void unlink_from_cell(std::uint32_t e);
