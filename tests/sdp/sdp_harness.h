@@ -23,6 +23,8 @@ inline SdpOptions small_sdp_options() {
   s.skeleton_max_side_m = 16.0;
   s.evaluations_per_scan = 4U;
   s.min_overlap_m2 = 1.0;
+  s.rounds_per_segment = 1U;   // keeps the tests quick: the small room overlaps everywhere
+  s.max_pairs_per_sample = 3U;
   return s;
 }
 
