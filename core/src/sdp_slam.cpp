@@ -1,6 +1,7 @@
 #include "sdpslam/core/sdp_slam.h"
 
 #include <cstdio>
+#include <cstring>
 #include <new>
 
 #include "sdpslam/core/det_math.h"
@@ -110,7 +111,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   total += 2U * bytes_of<std::uint16_t>(t * L) + bytes_of<double>(t) + bytes_of<std::uint8_t>(t) +
            bytes_of<std::uint32_t>(t);
   total += bytes_of<std::uint32_t>(L) + 2U * bytes_of<Pose2>(L) + bytes_of<Pose2>(n);
-  total += bytes_of<StampedPose>(ring_capacity_for(s));
+  total += bytes_of<StampedPose>(ring_capacity_for(s)) + bytes_of<IcpMemo>(kIcpMemoSlots);
   total += bytes_of<CellObservation>(fine) + bytes_of<std::uint8_t>(fine) + bytes_of<CellState>(cs * cs);
   return total + kSlack;
 }
@@ -176,6 +177,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   poses_scratch_ = arena.allocate_array<Pose2>(n_bottom_);
   ring_capacity_ = ring_capacity_for(s);
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
+  memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
   const std::uint32_t fs = fine_side_cells(b, s);
   fine_cells_ = static_cast<std::size_t>(fs) * fs;
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
@@ -185,12 +187,13 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
       perm_points_ == nullptr || choices_ == nullptr || scratch_choices_ == nullptr || error_ == nullptr ||
       has_error_ == nullptr || order_ == nullptr || chain_ == nullptr || frames_ == nullptr ||
       eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
-      fine_known_ == nullptr || coarse_ == nullptr) {
+      fine_known_ == nullptr || coarse_ == nullptr || memo_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
   }
   for (std::size_t i = 0; i < std::size_t{L} * n_bottom_; ++i) submaps_[i] = Submap{};
   for (std::uint32_t i = 0; i < L; ++i) levels_[i] = Level{};
+  for (std::uint32_t i = 0; i < kIcpMemoSlots; ++i) memo_[i] = IcpMemo{};
   for (std::uint32_t p = 0; p < n_top_; ++p) {
     error_[p] = 0.0;
     has_error_[p] = 0U;
@@ -732,21 +735,42 @@ void SdpSlam::evaluate(std::uint32_t p) {
       tframe = perm_[pi].frame_in_global;
     }
     const Pose2 guess = tframe.inverse().compose(eval_frames_[c.newer]);
-    const Icp2dResult r = icp_->match(target, tcount, live_points(first + c.newer, chain_[c.newer]), sn.point_count,
-                                      guess, options_.icp);
+    // Memo key: older submap (live level/node or permanent slot), newer level/node.
+    const std::uint64_t older_id =
+        c.older >= 0 ? (static_cast<std::uint64_t>(older_level) << 16U) | chain_[c.older]
+                     : (1ULL << 63U) | static_cast<std::uint64_t>(-c.older - 1) << 16U | perm_[-c.older - 1].level;
+    const std::uint64_t key =
+        (older_id * 0x9E3779B97F4A7C15ULL) ^ ((static_cast<std::uint64_t>(first + c.newer) << 16U) | chain_[c.newer]);
+    std::uint64_t gh = key;
+    const double gv[3] = {guess.x_m, guess.y_m, guess.heading_rad};
+    for (double v : gv) {
+      std::uint64_t b = 0U;
+      std::memcpy(&b, &v, sizeof b);
+      gh = splitmix64_next(gh) ^ b;
+    }
+    gh = splitmix64_next(gh);
+    IcpMemo& memo = memo_[gh % kIcpMemoSlots];
     double e = 0.0;
     double w = 0.0;
-    if (r.usable() && r.matched_pairs > 0U) {
-      ++stats_.icp_matches;
-      e = r.mean_nn_error_m;
-      w = static_cast<double>(r.matched_pairs);
-    } else if (r.status == Icp2dResult::Status::kInsufficientOverlap) {
-      ++stats_.icp_failures;
-      e = options_.icp.max_correspondence_m;
-      w = static_cast<double>(options_.icp.min_pairs);
+    if (memo.valid && memo.key == key && memo.guess_hash == gh) {
+      ++stats_.icp_memo_hits;
+      e = memo.error_m;
+      w = memo.weight;
     } else {
-      continue;
+      const Icp2dResult r = icp_->match(target, tcount, live_points(first + c.newer, chain_[c.newer]),
+                                        sn.point_count, guess, options_.icp);
+      if (r.usable() && r.matched_pairs > 0U) {
+        ++stats_.icp_matches;
+        e = r.mean_nn_error_m;
+        w = static_cast<double>(r.matched_pairs);
+      } else if (r.status == Icp2dResult::Status::kInsufficientOverlap) {
+        ++stats_.icp_failures;
+        e = options_.icp.max_correspondence_m;
+        w = static_cast<double>(options_.icp.min_pairs);
+      }
+      memo = IcpMemo{key, gh, e, w, true};
     }
+    if (!(w > 0.0)) continue;
     sum += e * w;
     pairs += w;
     if (older_level < lo) lo = older_level;

@@ -37,7 +37,7 @@ struct SdpOptions {
   // bottom filter's best submap (the others sample it from the PGS), [0, 1].
   double follow_best_fraction = 0.25;
   std::uint32_t rounds_per_segment = 3U;    // evaluation rounds after a segmentation, >= 1
-  std::uint32_t evaluations_per_scan = 8U;  // particles evaluated per scan (time budget), >= 1
+  std::uint32_t evaluations_per_scan = 3U;  // particles evaluated per scan (time budget), >= 1
   std::uint32_t max_pairs_per_sample = 6U;  // overlapping submap pairs matched per sample, >= 1
   double overlap_margin_m = 0.0;            // bounding boxes grown by this before the test
   double min_overlap_m2 = 4.0;              // pairs whose boxes share less area are ignored
@@ -56,19 +56,19 @@ struct SdpOptions {
                                    // never-evaluated particles when ranking)
   std::uint32_t max_permanent_submaps = 512U;  // 1 .. capacity::kMaxPermanentSubmaps
   // [sdp] skeleton (free-space points per submap, computed at anchorage)
-  std::uint32_t skeleton_points = 300U;  // per submap, 8 .. capacity::kMaxIcpPoints
+  std::uint32_t skeleton_points = 200U;  // per submap, 8 .. capacity::kMaxIcpPoints
   std::uint32_t skeleton_downsample = 2U;  // skeleton grid = map cells × this, 1 .. 8
   double skeleton_pad_m = 3.0;             // around the submap's path
-  double skeleton_max_side_m = 40.0;       // patch side bound (also the work buffers)
+  double skeleton_max_side_m = 30.0;       // patch side bound (also the work buffers)
   double skeleton_min_clearance_m = 0.2;
   double occupied_threshold = 0.6;  // occupancy >= this is an obstacle
   double free_threshold = 0.35;     // occupancy <= this is free
-  std::uint32_t work_cells_per_scan = 250000U;  // map cells read per scan by anchorage work
+  std::uint32_t work_cells_per_scan = 120000U;  // map cells read per scan by anchorage work
   // [sdp] ICP (Icp2d options)
   Icp2dOptions icp{};
 
   SdpOptions() {
-    icp.max_iterations = 20U;
+    icp.max_iterations = 15U;
     icp.max_correspondence_m = 0.6;
     icp.nn_cell_m = 0.3;
     icp.min_pairs = 20U;

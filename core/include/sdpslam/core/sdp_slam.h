@@ -87,6 +87,7 @@ struct SdpStats {
   std::uint64_t evaluations_with_overlap = 0U;
   std::uint64_t icp_matches = 0U;
   std::uint64_t icp_failures = 0U;          // overlapping boxes, too few correspondences
+  std::uint64_t icp_memo_hits = 0U;         // pair results reused instead of recomputed
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
   std::uint32_t max_live_levels = 0U;
@@ -187,6 +188,17 @@ class SdpSlam {
     std::uint32_t level = 0U;
     std::uint32_t point_count = 0U;
   };
+  // Memo of ICP results: many samples share a pair of submaps placed identically (elite
+  // copies, common chains), and ICP is deterministic, so the same inputs give the same
+  // result. Direct-mapped, keyed by the two submaps and the bits of the initial guess.
+  struct IcpMemo {
+    std::uint64_t key = 0U;
+    std::uint64_t guess_hash = 0U;
+    double error_m = 0.0;
+    double weight = 0.0;  // matched pairs; 0 = no usable result
+    bool valid = false;
+  };
+  static constexpr std::uint32_t kIcpMemoSlots = 1024U;
   struct Transfer {
     bool active = false;
     NodeId node = kNoNode;
@@ -281,6 +293,7 @@ class SdpSlam {
   std::size_t fine_cells_ = 0U;
   CellState* coarse_ = nullptr;
   std::uint32_t coarse_side_ = 0U;
+  IcpMemo* memo_ = nullptr;  // kIcpMemoSlots
   Transfer transfer_{};
   NodeId global_node_ = kNoNode;
 
