@@ -126,6 +126,14 @@ double BeamModel::gauss_mass(double abs_error_m) const {
 }
 
 double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
+  return log_likelihood_strided(map, particle, rays, robot, options_.weight_beam_stride, nullptr);
+}
+
+double BeamModel::log_likelihood_strided(const DpMap& map, NodeId particle, const ScanRays& rays,
+                                         const Pose2& robot, std::uint32_t stride, BeamScore* score) const {
+  if (stride == 0U) stride = 1U;
+  std::uint32_t beams = 0U;
+  std::uint32_t known_beams = 0U;
   const LaserFrame lf = laser_frame(rays, robot);
   const double res = resolution_m_;
   const double inv_res = 1.0 / res;
@@ -135,8 +143,10 @@ double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRa
   const double unknown = options_.unknown_stop_probability;
   double prod = 1.0;
   std::int64_t exponent = 0;
-  for (std::uint32_t b = 0; b < rays.count; b += options_.weight_beam_stride) {
+  for (std::uint32_t b = 0; b < rays.count; b += stride) {
     if (rays.kind[b] != static_cast<std::uint8_t>(RangeScan::Beam::kReturn)) continue;
+    ++beams;
+    bool known = false;
     const double r = static_cast<double>(rays.range_m[b]);
     const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
     const double dy = lf.s * rays.cos_a[b] + lf.c * rays.sin_a[b];
@@ -150,7 +160,9 @@ double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRa
     double like = 0.0;
     trace_cells(x0, y0, x1, y1, [&](std::int32_t ix, std::int32_t iy, bool) {
       CellObservation obs;
-      const double p = map.lookup(particle, ix, iy, &obs) ? stop_probability(obs) : unknown;
+      const bool seen = map.lookup(particle, ix, iy, &obs);
+      known = known || seen;
+      const double p = seen ? stop_probability(obs) : unknown;
       // Distance along the beam of the cell centre's projection.
       const double cx = ox + (static_cast<double>(ix) + 0.5) * res - lf.x_m;
       const double cy = oy + (static_cast<double>(iy) + 0.5) * res - lf.y_m;
@@ -161,6 +173,11 @@ double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRa
       return reach > 1e-6;
     });
     prod = mantissa_and_exponent(prod * (like + options_.floor_likelihood), &exponent);
+    if (known) ++known_beams;
+  }
+  if (score != nullptr) {
+    score->beams = beams;
+    score->known_beams = known_beams;
   }
   const double ll = det::log(prod) + static_cast<double>(exponent) * det::kLn2;
   return ll / options_.likelihood_temperature;

@@ -4,6 +4,7 @@
 
 #include "sdpslam/core/det_math.h"
 #include "sdpslam/core/resampling.h"
+#include "sdpslam/core/scan_matcher.h"
 
 namespace sdpslam {
 namespace {
@@ -148,10 +149,7 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   const std::uint32_t n = particle_count_;
   prepare_rays(scan, &rays_);
   // 1-2. propagate and weight.
-  for (std::uint32_t i = 0; i < n; ++i) {
-    proposed_[i] = motion_.sample(particles_[i].pose, delta, rng_);
-    log_w_[i] = particles_[i].log_weight + beam_.log_likelihood(map_, particles_[i].node, rays_, proposed_[i]);
-  }
+  for (std::uint32_t i = 0; i < n; ++i) log_w_[i] = particles_[i].log_weight + propose(i, delta);
   if (!normalize_log_weights(log_w_, n, w_)) ++stats_.degenerate_weight_count;
   const double neff = effective_sample_size(w_, n);
   std::uint32_t best = 0U;
@@ -227,6 +225,37 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   result.effective_sample_size = neff;
   result.map_updates_dropped = dropped;
   return result;
+}
+
+double DpSlamFilter::propose(std::uint32_t i, const Pose2& delta) {
+  const Particle& p = particles_[i];
+  if (options_.proposal == DpSlamOptions::Proposal::kScanMatch) {
+    // Improved proposal (Grisetti et al. 2007, §IV): match from the odometry prediction.
+    const Pose2 predicted = p.pose.compose(delta);
+    const ScanMatch m = match_scan(beam_, map_, p.node, rays_, predicted, options_.match);
+    stats_.proposal_evaluations += m.evaluations;
+    switch (m.outcome) {
+      case ScanMatch::Outcome::kMatched: {
+        ++stats_.proposal_matched;
+        const double ex = rng_.gaussian(options_.proposal_sigma_xy_m);
+        const double ey = rng_.gaussian(options_.proposal_sigma_xy_m);
+        const double et = rng_.gaussian(options_.proposal_sigma_rot_rad);
+        proposed_[i] = Pose2{m.pose.x_m + ex, m.pose.y_m + ey, normalize_angle_rad(m.pose.heading_rad + et)};
+        if (options_.proposal_weight == DpSlamOptions::ProposalWeight::kNeighbourhood) {
+          // Matcher beams → the weighting beam count, so that fallback particles compare.
+          const double scale = static_cast<double>(options_.match.beam_stride) /
+                               static_cast<double>(options_.beam.weight_beam_stride);
+          return m.neighbourhood_log_likelihood * scale;
+        }
+        return beam_.log_likelihood(map_, p.node, rays_, m.pose);
+      }
+      case ScanMatch::Outcome::kTooFewBeams: ++stats_.proposal_fallback_few_beams; break;
+      case ScanMatch::Outcome::kMapTooEmpty: ++stats_.proposal_fallback_empty_map; break;
+      case ScanMatch::Outcome::kScoreTooLow: ++stats_.proposal_fallback_low_score; break;
+    }
+  }
+  proposed_[i] = motion_.sample(p.pose, delta, rng_);
+  return beam_.log_likelihood(map_, p.node, rays_, proposed_[i]);
 }
 
 bool DpSlamFilter::is_particle_node(NodeId node) const {

@@ -67,6 +67,18 @@ bool DpSlamOptions::validate(char* why, std::size_t n) const {
   c.open_low("observation.max_update_range_m", beam.max_update_range_m, 0.0, 200.0);
   c.real("observation.no_return_free_m", beam.no_return_free_m, 0.0, 200.0);
   c.real("observation.likelihood_temperature", beam.likelihood_temperature, 1.0, 1000.0);
+  c.open_low("proposal.linear_step_m", match.linear_step_m, 0.0, 1.0);
+  c.open_low("proposal.angular_step_rad", match.angular_step_rad, 0.0, 0.5);
+  c.integer("proposal.refinements", match.refinements, 0U, 10U);
+  c.integer("proposal.max_iterations", match.max_iterations, 1U, 100U);
+  c.integer("proposal.beam_stride", match.beam_stride, 1U, capacity::kMaxBeams);
+  c.integer("proposal.min_beams", match.min_beams, 1U, capacity::kMaxBeams);
+  c.real("proposal.min_known_fraction", match.min_known_fraction, 0.0, 1.0);
+  c.real("proposal.min_mean_log_likelihood", match.min_mean_log_likelihood, -50.0, 0.0);
+  c.real("proposal.sample_sigma_xy_m", proposal_sigma_xy_m, 0.0, 1.0);
+  c.real("proposal.sample_sigma_rot_rad", proposal_sigma_rot_rad, 0.0, 0.5);
+  c.integer("proposal.kind", static_cast<std::uint64_t>(proposal), 0U, 1U);
+  c.integer("proposal.weight", static_cast<std::uint64_t>(proposal_weight), 0U, 1U);
   c.real("map.resolution_m", map_resolution_m, 0.005, 1.0);
   c.real("map.width_m", map_width_m, 1.0, 10000.0);
   c.real("map.height_m", map_height_m, 1.0, 10000.0);

@@ -17,7 +17,8 @@ class CountingSink final : public PoseSink {
 
 TEST_GROUP(DpSlamNoHeap){};
 
-TEST(DpSlamNoHeap, hundreds_of_scans_after_init_allocate_nothing) {
+namespace {
+void run_without_heap(const DpSlamOptions& options) {
   CHECK_TRUE(sdpslam::test::allocation_counting_active());
   const test::SimRun run = test::make_loop(2);  // two loops: ~700 scans
   const auto world = test::room_world();
@@ -29,7 +30,7 @@ TEST(DpSlamNoHeap, hundreds_of_scans_after_init_allocate_nothing) {
     test::make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, scans.back().get());
   }
   test::FilterRig rig;
-  CHECK_TRUE(rig.init(test::sim_options(20), 9));
+  CHECK_TRUE(rig.init(options, 9));
   CountingSink sink;
   rig.filter->set_pose_sink(&sink);
   std::size_t processed = 0;
@@ -52,4 +53,14 @@ TEST(DpSlamNoHeap, hundreds_of_scans_after_init_allocate_nothing) {
   CHECK(sink.count > 0U);
   CHECK(checksum == checksum);
   CHECK(rig.filter->stats().resamplings > 0U);
+}
+
+}  // namespace
+
+TEST(DpSlamNoHeap, hundreds_of_scans_after_init_allocate_nothing) { run_without_heap(test::sim_options(20)); }
+
+TEST(DpSlamNoHeap, improved_proposal_allocates_nothing_either) {
+  DpSlamOptions o = test::sim_options(20);
+  o.proposal = DpSlamOptions::Proposal::kScanMatch;
+  run_without_heap(o);
 }

@@ -41,7 +41,45 @@ TEST(SlamConfig, shipped_default_config_loads_and_equals_the_built_in_defaults) 
   DOUBLES_EQUAL(d.map_width_m, c.filter.map_width_m, 0.0);
   LONGS_EQUAL(d.path_entries_per_particle, c.filter.path_entries_per_particle);
   LONGS_EQUAL(d.beam.weight_beam_stride, c.filter.beam.weight_beam_stride);
+  CHECK(c.filter.proposal == d.proposal);
+  CHECK(c.filter.proposal_weight == d.proposal_weight);
+  DOUBLES_EQUAL(d.match.linear_step_m, c.filter.match.linear_step_m, 0.0);
+  DOUBLES_EQUAL(d.match.angular_step_rad, c.filter.match.angular_step_rad, 0.0);
+  LONGS_EQUAL(d.match.refinements, c.filter.match.refinements);
+  LONGS_EQUAL(d.match.max_iterations, c.filter.match.max_iterations);
+  LONGS_EQUAL(d.match.beam_stride, c.filter.match.beam_stride);
+  LONGS_EQUAL(d.match.min_beams, c.filter.match.min_beams);
+  DOUBLES_EQUAL(d.match.min_known_fraction, c.filter.match.min_known_fraction, 0.0);
+  DOUBLES_EQUAL(d.match.min_mean_log_likelihood, c.filter.match.min_mean_log_likelihood, 0.0);
+  DOUBLES_EQUAL(d.proposal_sigma_xy_m, c.filter.proposal_sigma_xy_m, 0.0);
+  DOUBLES_EQUAL(d.proposal_sigma_rot_rad, c.filter.proposal_sigma_rot_rad, 0.0);
   CHECK(c.filter.validate(nullptr, 0));
+}
+
+TEST(SlamConfig, proposal_section_selects_the_improved_proposal) {
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(slam::load_config_ini(write_temp("[proposal]\nkind = scan_match\nweight = neighbourhood\n"
+                                                   "beam_stride = 3\nsample_sigma_rot_rad = 0.01\n"),
+                                        &c, &error),
+                  error.c_str());
+  CHECK(c.filter.proposal == DpSlamOptions::Proposal::kScanMatch);
+  CHECK(c.filter.proposal_weight == DpSlamOptions::ProposalWeight::kNeighbourhood);
+  LONGS_EQUAL(3, c.filter.match.beam_stride);
+  DOUBLES_EQUAL(0.01, c.filter.proposal_sigma_rot_rad, 0.0);
+}
+
+TEST(SlamConfig, unknown_proposal_kind_and_bad_matcher_values_are_rejected) {
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(write_temp("[proposal]\nkind = icp\n"), &c, &error));
+  STRCMP_CONTAINS(":2:", error.c_str());
+  STRCMP_CONTAINS("odometry or scan_match", error.c_str());
+  CHECK_FALSE(slam::load_config_ini(write_temp("[proposal]\nweight = max\n"), &c, &error));
+  STRCMP_CONTAINS("match or neighbourhood", error.c_str());
+  slam::SlamConfig c2;
+  CHECK_FALSE(slam::load_config_ini(write_temp("[proposal]\nrefinements = 11\n"), &c2, &error));
+  STRCMP_CONTAINS("proposal.refinements", error.c_str());
 }
 
 TEST(SlamConfig, unknown_key_is_rejected_with_file_and_line) {

@@ -92,6 +92,39 @@ bool set_option(DpSlamOptions& o, const std::string& section, const std::string&
     if (name == "max_update_range_m") return real(o.beam.max_update_range_m);
     if (name == "no_return_free_m") return real(o.beam.no_return_free_m);
     if (name == "likelihood_temperature") return real(o.beam.likelihood_temperature);
+  } else if (section == "proposal") {
+    if (name == "kind") {
+      if (std::strcmp(value, "odometry") == 0) {
+        o.proposal = DpSlamOptions::Proposal::kOdometry;
+      } else if (std::strcmp(value, "scan_match") == 0) {
+        o.proposal = DpSlamOptions::Proposal::kScanMatch;
+      } else {
+        *why = "'" + std::string(value) + "' is not odometry or scan_match";
+        return false;
+      }
+      return true;
+    }
+    if (name == "weight") {
+      if (std::strcmp(value, "match") == 0) {
+        o.proposal_weight = DpSlamOptions::ProposalWeight::kMatch;
+      } else if (std::strcmp(value, "neighbourhood") == 0) {
+        o.proposal_weight = DpSlamOptions::ProposalWeight::kNeighbourhood;
+      } else {
+        *why = "'" + std::string(value) + "' is not match or neighbourhood";
+        return false;
+      }
+      return true;
+    }
+    if (name == "linear_step_m") return real(o.match.linear_step_m);
+    if (name == "angular_step_rad") return real(o.match.angular_step_rad);
+    if (name == "refinements") return u32(o.match.refinements);
+    if (name == "max_iterations") return u32(o.match.max_iterations);
+    if (name == "beam_stride") return u32(o.match.beam_stride);
+    if (name == "min_beams") return u32(o.match.min_beams);
+    if (name == "min_known_fraction") return real(o.match.min_known_fraction);
+    if (name == "min_mean_log_likelihood") return real(o.match.min_mean_log_likelihood);
+    if (name == "sample_sigma_xy_m") return real(o.proposal_sigma_xy_m);
+    if (name == "sample_sigma_rot_rad") return real(o.proposal_sigma_rot_rad);
   } else if (section == "map") {
     if (name == "resolution_m") return real(o.map_resolution_m);
     if (name == "width_m") return real(o.map_width_m);
@@ -124,8 +157,8 @@ int handler(void* user, const char* section, const char* name, const char* value
 }  // namespace
 
 bool is_slam_config_section(const std::string& section) {
-  return section == "filter" || section == "motion" || section == "observation" || section == "map" ||
-         section == "capacity" || section == "log";
+  return section == "filter" || section == "motion" || section == "observation" || section == "proposal" ||
+         section == "map" || section == "capacity" || section == "log";
 }
 
 ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, const std::string& key,

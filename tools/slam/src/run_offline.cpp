@@ -142,6 +142,10 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
   js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
+  js += "  \"proposal\": {\"matched\": " + u(st.proposal_matched) + ", \"fallback_few_beams\": " +
+        u(st.proposal_fallback_few_beams) + ", \"fallback_empty_map\": " + u(st.proposal_fallback_empty_map) +
+        ", \"fallback_low_score\": " + u(st.proposal_fallback_low_score) + ", \"evaluations\": " +
+        u(st.proposal_evaluations) + "},\n";
   js += "  \"pools\": {\n";
   js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
         ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(st.node_fallback_count) + "},\n";

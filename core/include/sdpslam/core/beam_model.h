@@ -61,6 +61,12 @@ struct ScanRays {
 };
 void prepare_rays(const RangeScan& scan, ScanRays* out);
 
+// What one strided evaluation looked at (for the scan matcher's failure tests).
+struct BeamScore {
+  std::uint32_t beams = 0U;        // return beams evaluated
+  std::uint32_t known_beams = 0U;  // ... whose window met at least one observed cell
+};
+
 class BeamModel {
  public:
   static constexpr std::uint32_t kStopLutSide = 64U;
@@ -74,6 +80,11 @@ class BeamModel {
   // log p(scan | pose, particle's map), divided by likelihood_temperature. Costs
   // ~(beams / stride) · (2·window / cell) map lookups.
   double log_likelihood(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const;
+  // The same on every `stride`-th beam (stride ≥ 1; 0 is taken as 1), filling `score`
+  // (may be null). log_likelihood() is this with stride = weight_beam_stride, bit for
+  // bit. Used by the scan matcher of the improved proposal (scan_matcher.h).
+  double log_likelihood_strided(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
+                                std::uint32_t stride, BeamScore* score) const;
 
   // Writes the scan into `particle`'s map. Returns the number of cell updates the map
   // dropped (0 normally).

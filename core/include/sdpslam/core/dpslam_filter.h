@@ -4,7 +4,9 @@
 //
 // Each processed scan:
 //   1. propagate: every particle samples a pose from the odometry motion model
-//      (motion_model.h) around its previous pose;
+//      (motion_model.h) around its previous pose; or, with the improved proposal
+//      (DpSlamOptions::proposal), around a scan match against its own map view
+//      (scan_matcher.h), falling back to the odometry model where the match fails;
 //   2. weight: log p(scan | pose, particle's map) through the DP map (beam_model.h);
 //   3. resample (low variance) iff N_eff < resample_neff_ratio · N (resampling.h);
 //   4. map update: every particle that survives resampling writes the scan into its own
@@ -65,6 +67,12 @@ struct DpSlamStats {
   std::uint64_t map_updates_dropped = 0U;
   std::uint64_t node_fallback_count = 0U;
   std::uint64_t degenerate_weight_count = 0U;  // all weights -inf/NaN: kept uniform
+  // Improved proposal (DpSlamOptions::Proposal::kScanMatch), per particle and step:
+  std::uint64_t proposal_matched = 0U;              // drawn around a scan match
+  std::uint64_t proposal_fallback_few_beams = 0U;   // odometry proposal: too few beams
+  std::uint64_t proposal_fallback_empty_map = 0U;   // ... map too empty at the prediction
+  std::uint64_t proposal_fallback_low_score = 0U;   // ... match scored below the threshold
+  std::uint64_t proposal_evaluations = 0U;          // observation-model calls by the matcher
 };
 
 class DpSlamFilter {
@@ -142,6 +150,9 @@ class DpSlamFilter {
   };
 
   void first_scan(const OdometrySample& odom, const RangeScan& scan, StepResult* result);
+  // Draws particle i's pose into proposed_[i] (odometry or improved proposal) and returns
+  // the log-weight increment.
+  double propose(std::uint32_t i, const Pose2& odom_delta);
   bool is_particle_node(NodeId node) const;
 
   DpSlamOptions options_{};

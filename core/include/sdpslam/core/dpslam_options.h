@@ -8,6 +8,7 @@
 #include "sdpslam/core/beam_model.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/scan_matcher.h"
 
 namespace sdpslam {
 
@@ -21,6 +22,23 @@ struct DpSlamOptions {
   MotionModelOptions motion;
   // [observation]
   BeamModelOptions beam;
+  // [proposal]: how a particle's new pose is drawn.
+  //  kOdometry  — the paper's: sample the odometry motion model (motion_model.h).
+  //  kScanMatch — the improved proposal (Grisetti et al. 2007, §IV): from the
+  //    odometry-predicted pose, hill-climb against the particle's own map view
+  //    (scan_matcher.h), then sample N(match, diag(sample_sigma_xy², ·, sample_sigma_rot²))
+  //    and weight by the likelihood at the match (weighting below). A failed match falls
+  //    back to the odometry proposal for that particle (counted in DpSlamStats).
+  enum class Proposal : std::uint8_t { kOdometry, kScanMatch };
+  enum class ProposalWeight : std::uint8_t {
+    kMatch,          // observation model at the matched pose (weight_beam_stride beams)
+    kNeighbourhood,  // mean likelihood over the finest level's evaluated poses (GMapping)
+  };
+  Proposal proposal = Proposal::kOdometry;
+  ProposalWeight proposal_weight = ProposalWeight::kMatch;
+  ScanMatcherOptions match;
+  double proposal_sigma_xy_m = 0.01;        // noise around the match, [0, 1]
+  double proposal_sigma_rot_rad = 0.005;    // [0, 0.5]
   // [map]: a fixed area centred on the first pose
   double map_resolution_m = 0.05;
   double map_width_m = 120.0;
