@@ -48,8 +48,7 @@ if(TARGET sdpslam_io)
 endif()
 
 install(TARGETS ${_sdpslam_export_targets} EXPORT sdpslamTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 
 # Public headers: every include/ folder of an exported library (include/sdpslam/<part>/).
 foreach(target IN LISTS _sdpslam_export_targets)
