@@ -47,7 +47,7 @@ observations_per_particle = 20000
 period_s = 5
 INI
 sed -n '/^\[filter\]/,/^\[output\]/p' "$work/sdpslamd.ini" | grep -v '^\[output\]' >"$work/offline.ini"
-"$sdpslam" run "$work/log.dat" --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
+"$sdpslam" run "$work/log.dat" --mode dpslam --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
 start=$(date +%s)
 sh "$run" --cache "$cache" --work "$work/vm" --timeout 280 \
   --file "$daemon:sdpslamd_static" --file "$replay:sdpslamd_replay_static" --file "$work/log.dat" \
@@ -66,4 +66,4 @@ echo "HIL sdpslamd test: $((end - start)) s in the machine (boot to power-off)"
 grep -q '"dropped_total": 0' "$work/status.json" || { echo "FAIL: sdpslamd dropped scans"; exit 1; }
 grep -q '"rx_overflows": 0' "$work/status.json" || { echo "FAIL: CAN frames lost"; exit 1; }
 set -- $(sed -n 's/^timeline: play_start_us \([0-9]*\) log_start_us \([0-9]*\) speed \(.*\)/\1 \2 \3/p' "$work/console.txt")
-sh "$here/../sdpslamd/compare_trajectories.sh" "$work/trajectory.txt" "$work/offline/trajectory.txt" "$1" "$2" "$3" 0.5 0.3
+sh "$here/../sdpslamd/compare_trajectories.sh" "$work/trajectory.txt" "$work/offline/trajectory.txt" "$1" "$2" "$3" 2.0 0.8 0.5

@@ -62,11 +62,11 @@ cat "$work/replay.log"
 end=$(date +%s.%N)
 cat "$work/daemon.log" | tail -n 5
 [ $rc = 0 ] || { echo "FAIL: replay or sdpslamd failed ($rc)"; exit 1; }
-"$sdpslam" run "$work/log.dat" --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
+"$sdpslam" run "$work/log.dat" --mode dpslam --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
 ls "$work/daemon" | grep -q '\.tmp' && { echo "FAIL: temporary files left"; exit 1; }
 grep -o '"scans": {[^}]*}' "$work/daemon/status.json"
 grep -o '"from_scan_stamp": {[^}]*}' "$work/daemon/status.json"
 grep -o '"cpu": {[^}]*}' "$work/daemon/status.json"
 grep -q '"dropped_total": 0' "$work/daemon/status.json" || { echo "FAIL: sdpslamd dropped scans"; exit 1; }
 set -- $(sed -n 's/^timeline: play_start_us \([0-9]*\) log_start_us \([0-9]*\) speed \(.*\)/\1 \2 \3/p' "$work/replay.log")
-sh "$(dirname "$0")/compare_trajectories.sh" "$work/daemon/trajectory.txt" "$work/offline/trajectory.txt" "$1" "$2" "$3" 0.5 0.3
+sh "$(dirname "$0")/compare_trajectories.sh" "$work/daemon/trajectory.txt" "$work/offline/trajectory.txt" "$1" "$2" "$3" 2.0 0.8 0.5
