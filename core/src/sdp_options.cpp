@@ -69,6 +69,8 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("occupied_threshold", occupied_threshold, 0.0, 1.0);
   c.real("free_threshold", free_threshold, 0.0, occupied_threshold);
   c.integer("work_cells_per_scan", work_cells_per_scan, 1024U, 1U << 28U);
+  c.integer("map_tile_capacity", map_tile_capacity, 0U, capacity::kDpMaxTiles);
+  c.integer("map_observation_capacity", map_observation_capacity, 0U, 0xE0000000U);
   if (c.ok && !icp.valid()) c.fail("icp: options out of range (see icp2d.h Icp2dOptions::valid)");
   return c.ok;
 }

@@ -89,6 +89,11 @@ DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const Sdp
   b.extra_ancestry_nodes = sdp.max_levels * 2U * n + n + 8U;
   // Anchored leaves keep their uncommitted poses: at most N × segment length per segment.
   b.extra_path_entries = (sdp.max_levels + 1U) * n * sdp.max_segment_scans;
+  if (sdp.map_tile_capacity != 0U) b.map_tile_capacity = sdp.map_tile_capacity;
+  if (sdp.map_observation_capacity != 0U) {
+    b.map_observations_base = sdp.map_observation_capacity;
+    b.map_observations_per_particle = 1U;
+  }
   return b;
 }
 
@@ -111,7 +116,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   total += 2U * bytes_of<std::uint16_t>(t * L) + bytes_of<double>(t) + bytes_of<std::uint8_t>(t) +
            bytes_of<std::uint32_t>(t);
   total += bytes_of<std::uint32_t>(L) + 2U * bytes_of<Pose2>(L) + bytes_of<Pose2>(n);
-  total += bytes_of<StampedPose>(ring_capacity_for(s)) + bytes_of<IcpMemo>(kIcpMemoSlots);
+  total += bytes_of<StampedPose>(ring_capacity_for(s)) + bytes_of<IcpMemo>(kIcpMemoSlots) + bytes_of<NodeId>(n);
   total += bytes_of<CellObservation>(fine) + bytes_of<std::uint8_t>(fine) + bytes_of<CellState>(cs * cs);
   return total + kSlack;
 }
@@ -178,6 +183,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   ring_capacity_ = ring_capacity_for(s);
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
   memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
+  release_queue_ = arena.allocate_array<NodeId>(n_bottom_);
   const std::uint32_t fs = fine_side_cells(b, s);
   fine_cells_ = static_cast<std::size_t>(fs) * fs;
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
@@ -187,7 +193,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
       perm_points_ == nullptr || choices_ == nullptr || scratch_choices_ == nullptr || error_ == nullptr ||
       has_error_ == nullptr || order_ == nullptr || chain_ == nullptr || frames_ == nullptr ||
       eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
-      fine_known_ == nullptr || coarse_ == nullptr || memo_ == nullptr) {
+      fine_known_ == nullptr || coarse_ == nullptr || memo_ == nullptr || release_queue_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
   }
@@ -399,7 +405,8 @@ void SdpSlam::segment(std::int64_t stamp_us) {
 void SdpSlam::make_oldest_permanent() {
   const std::uint32_t level = graph_.first_live_level();
   if (!graph_.is_live(level)) return;
-  // Pending work on this level first (its skeletons, the previous transfer).
+  // Pending work first (the previous level's releases and transfer, this level's skeletons).
+  while (release_count_ > 0U) release_one();
   while (transfer_.active) transfer_rows(0xFFFFFFFFU);
   const std::uint32_t count = levels_[slot(level)].count;
   for (std::uint32_t k = 0; k < count; ++k) {
@@ -436,8 +443,7 @@ void SdpSlam::make_oldest_permanent() {
   // The other submaps of the level are released now; the chosen one once its map has
   // been copied into the global map node.
   for (std::uint32_t k = 0; k < count; ++k) {
-    if (k == chosen) continue;
-    if (filter_->release_anchored(submap(level, k).node)) ++stats_.submaps_released;
+    if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = submap(level, k).node;
   }
   if (global_node_ == kNoNode) global_node_ = filter_->create_anchored_root();
   transfer_ = Transfer{};
@@ -501,8 +507,15 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   return used > 0U ? used : 1U;
 }
 
+std::uint32_t SdpSlam::release_one() {
+  if (release_count_ == 0U) return 0U;
+  const NodeId node = release_queue_[--release_count_];
+  if (filter_->release_anchored(node)) ++stats_.submaps_released;
+  return 1U;
+}
+
 std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
-  std::uint32_t used = 0U;
+  std::uint32_t used = release_one();
   // Skeletons of the live levels, oldest first.
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
     for (std::uint32_t k = 0; k < levels_[slot(lv)].count && used < budget_cells; ++k) {

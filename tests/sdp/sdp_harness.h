@@ -25,6 +25,8 @@ inline SdpOptions small_sdp_options() {
   s.min_overlap_m2 = 1.0;
   s.rounds_per_segment = 1U;   // keeps the tests quick: the small room overlaps everywhere
   s.max_pairs_per_sample = 3U;
+  s.map_tile_capacity = 0U;         // the DP map is sized by the bottom options here
+  s.map_observation_capacity = 0U;
   return s;
 }
 

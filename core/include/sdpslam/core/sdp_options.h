@@ -64,6 +64,10 @@ struct SdpOptions {
   double occupied_threshold = 0.6;  // occupancy >= this is an obstacle
   double free_threshold = 0.35;     // occupancy <= this is free
   std::uint32_t work_cells_per_scan = 120000U;  // map cells read per scan by anchorage work
+  // [sdp] fixed memory of the shared DP map in SDP mode (0 = keep the [map] values):
+  // tiles that may hold data and observations for every live submap and the global map.
+  std::uint32_t map_tile_capacity = 8000U;
+  std::uint32_t map_observation_capacity = 1600000U;
   // [sdp] ICP (Icp2d options)
   Icp2dOptions icp{};
 

@@ -40,7 +40,8 @@
 // sink in the global frame, its map is copied into one global "permanent map" node
 // (a tree root that is not a particle) and its skeleton into a ring of permanent
 // submaps (still matched for loop closures); the level's other submaps are released
-// (set_active(false) + prune frees their DP-map observations; counted).
+// (set_active(false) + prune frees their DP-map observations; counted), one submap per
+// call of process() so that no single scan pays for all of them.
 //
 // Worst-scan time: anchorage work (skeleton extraction, map transfer) is done in chunks
 // of at most work_cells_per_scan map cells per call of process(), and top-level samples
@@ -245,6 +246,7 @@ class SdpSlam {
   std::uint32_t do_work(std::uint32_t budget_cells);
   std::uint32_t extract_skeleton(std::uint32_t level, std::uint32_t node);
   std::uint32_t transfer_rows(std::uint32_t budget_cells);
+  std::uint32_t release_one();
   void rank_particles();
   void resample_and_diversify();
   void extend_to_level(std::uint32_t level, std::uint32_t bottom_best);
@@ -294,6 +296,10 @@ class SdpSlam {
   CellState* coarse_ = nullptr;
   std::uint32_t coarse_side_ = 0U;
   IcpMemo* memo_ = nullptr;  // kIcpMemoSlots
+  // Submaps of a permanent level waiting to be released, one per call of process()
+  // (freeing a submap's observations walks their cell lists: spread over scans).
+  NodeId* release_queue_ = nullptr;  // N
+  std::uint32_t release_count_ = 0U;
   Transfer transfer_{};
   NodeId global_node_ = kNoNode;
 
