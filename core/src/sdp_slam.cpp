@@ -776,6 +776,11 @@ void SdpSlam::evaluate(std::uint32_t p) {
         ++stats_.icp_matches;
         e = r.mean_nn_error_m;
         w = static_cast<double>(r.matched_pairs);
+        if (options_.icp_correction_weight > 0.0) {
+          const Pose2 d = between(guess, r.transform);
+          e += options_.icp_correction_weight *
+               (det::sqrt(d.x_m * d.x_m + d.y_m * d.y_m) + options_.icp_correction_lever_m * (d.heading_rad < 0.0 ? -d.heading_rad : d.heading_rad));
+        }
       } else if (r.status == Icp2dResult::Status::kInsufficientOverlap) {
         ++stats_.icp_failures;
         e = options_.icp.max_correspondence_m;

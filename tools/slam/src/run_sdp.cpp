@@ -285,6 +285,8 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "icp_max_correspondence_m") ok = real(&t.icp.max_correspondence_m);
   else if (key == "icp_nn_cell_m") ok = real(&t.icp.nn_cell_m);
   else if (key == "icp_min_pairs") ok = integer(&t.icp.min_pairs);
+  else if (key == "icp_correction_weight") ok = real(&t.icp_correction_weight);
+  else if (key == "icp_correction_lever_m") ok = real(&t.icp_correction_lever_m);
   else return SdpKeyResult::kUnknown;
   if (!ok) {
     if (why != nullptr) *why = "[sdp] " + key + ": malformed value '" + v + "'";

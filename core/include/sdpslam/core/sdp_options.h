@@ -70,6 +70,12 @@ struct SdpOptions {
   std::uint32_t map_observation_capacity = 1600000U;
   // [sdp] ICP (Icp2d options)
   Icp2dOptions icp{};
+  // Beyond the paper: the ICP residual alone barely depends on how well the chain placed
+  // the two submaps (ICP removes the misplacement before measuring), so a sample's
+  // error may also charge the correction ICP had to apply: error = residual +
+  // icp_correction_weight × (|Δt| + icp_correction_lever_m × |Δθ|). 0 = the paper's error.
+  double icp_correction_weight = 0.0;
+  double icp_correction_lever_m = 1.0;
 
   SdpOptions() {
     icp.max_iterations = 15U;
