@@ -51,12 +51,7 @@ bool Daemon::start(std::string* error) {
   return true;
 }
 
-void Daemon::update_odometry() {
-  if (!encoders_started_) {
-    encoders_started_ = io_.start_encoders == nullptr || io_.start_encoders(io_.start_ctx) == 1;
-  }
-  odom_.update();
-  const hal::OdometryReading r = odom_.latest();
+void Daemon::take_odometry(const hal::OdometryReading& r) {
   if (r.status == hal::OdometryStatus::kValid && r.stamp_us > last_odom_stamp_us_) {
     if (ring_.push(r.stamp_us, r.pose)) ++counters_.odometry_samples;
     last_odom_stamp_us_ = r.stamp_us;
@@ -66,6 +61,23 @@ void Daemon::update_odometry() {
     ring_.mark_break();
     if (ring_.push(r.stamp_us, r.pose)) ++counters_.odometry_samples;
     last_odom_stamp_us_ = r.stamp_us;
+  }
+}
+
+void Daemon::update_odometry() {
+  if (!encoders_started_) {
+    encoders_started_ = io_.start_encoders == nullptr || io_.start_encoders(io_.start_ctx) == 1;
+  }
+  // Drain what the bus holds, integrating after every frame: a backlog that built up
+  // while a scan was being processed then yields every intermediate pose at its own
+  // kernel receive stamp, instead of one jump to the newest pair (which left gaps the
+  // interpolation refuses). Bounded so a flooded bus cannot starve the laser.
+  hal::OdometryReading r = odom_.latest();
+  for (std::uint32_t frame = 0; frame < kMaxFramesPerOdometryUpdate; ++frame) {
+    odom_.update();
+    r = odom_.latest();
+    take_odometry(r);
+    if (io_.bus == nullptr || io_.bus->wait_readable(0) <= 0) break;
   }
   if (r.status != seen_odom_) {
     if (r.status == hal::OdometryStatus::kStale) {

@@ -150,7 +150,12 @@ int main(int argc, char** argv) {
     }
     bus = std::move(sb);
   }
-  drivers::CanWheelEncoders encoders(*bus, clock, config.encoders);
+  // One frame per update: the loop drains the bus frame by frame so that every encoder
+  // sample enters the odometry ring with its own receive stamp (Daemon::update_odometry).
+  drivers::CanWheelEncoderConfig encoder_config = config.encoders;
+  encoder_config.canopen.max_frames_per_update = 1;
+  encoder_config.odrive.max_frames_per_update = 1;
+  drivers::CanWheelEncoders encoders(*bus, clock, encoder_config);
 
   // Laser on its serial device; a device that is absent now is re-opened when it appears.
   drivers::SerialOptions po;

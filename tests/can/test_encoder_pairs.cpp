@@ -459,3 +459,56 @@ TEST(CanWheelEncoders, odrive_selected_by_config_reads_estimates) {
   LONGS_EQUAL(1, bus.stats().rx_filtered);
   LONGS_EQUAL(0, enc.odrive()->stats().unexpected_frames);
 }
+
+namespace {
+// A bus holding frames that were received (kernel stamps) long before they are read, as
+// after the host was busy processing a scan.
+class BacklogBus final : public hal::CanBus {
+ public:
+  int send(const hal::CanFrame&) override { return 1; }
+  int receive(hal::CanFrame& out) override {
+    if (next >= count) return 0;
+    out = frames[next++];
+    return 1;
+  }
+  int wait_readable(std::int64_t) override { return next < count ? 1 : 0; }
+  hal::CanBusState state() const override { return hal::CanBusState::kActive; }
+  const hal::CanBusStats& stats() const override { return stats_; }
+  hal::CanFrame frames[64];
+  int count = 0;
+  int next = 0;
+
+ private:
+  hal::CanBusStats stats_{};
+};
+}  // namespace
+
+TEST_GROUP(EncoderBacklog){};
+
+TEST(EncoderBacklog, backlog_read_frame_by_frame_keeps_both_wheels_fresh) {
+  test::FakeClock clock;
+  clock.t_us = 10000000;
+  BacklogBus bus;
+  for (int k = 0; k < 10; ++k) {  // 50 Hz pairs, received ~3 s before they are read
+    const std::int64_t stamp = 7000000 + 20000 * k;
+    canopen::make_tpdo1_position(5, static_cast<std::uint32_t>(10 * k), 4, bus.frames[bus.count]);
+    bus.frames[bus.count++].stamp_us = stamp;
+    canopen::make_tpdo1_position(6, static_cast<std::uint32_t>(20 * k), 4, bus.frames[bus.count]);
+    bus.frames[bus.count++].stamp_us = stamp + 1000;
+  }
+  CanOpenEncoderOptions o = canopen_options();
+  o.max_frames_per_update = 1;
+  CanOpenEncoderPair enc(bus, clock, o);
+  enc.update();  // left only: the right wheel has no sample yet
+  CHECK_FALSE(enc.latest().both_fresh());
+  for (int i = 1; i < bus.count; ++i) {
+    enc.update();
+    CHECK_TRUE(enc.latest().both_fresh());  // judged at the newest frame's receive stamp
+  }
+  LONGS_EQUAL(90, enc.latest().left.raw_count);
+  LONGS_EQUAL(7180000, enc.latest().left.stamp_us);
+  // Once the backlog is read, silence is judged on the clock again.
+  clock.t_us += 60000;
+  enc.update();
+  CHECK_FALSE(enc.latest().both_fresh());
+}

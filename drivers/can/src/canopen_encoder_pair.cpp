@@ -137,6 +137,7 @@ int CanOpenEncoderPair::update() {
   if (started_ && nmt_pending_ != 0) start();
   int new_samples = 0;
   int result = 0;
+  std::int64_t newest_frame_stamp_us = 0;
   for (int i = 0; i < options_.max_frames_per_update; ++i) {
     hal::CanFrame f;
     const int r = bus_.receive(f);
@@ -150,14 +151,19 @@ int CanOpenEncoderPair::update() {
       continue;  // e.g. one bad datagram: keep reading
     }
     const auto before = stats_.positions[0] + stats_.positions[1];
+    if (f.stamp_us > newest_frame_stamp_us) newest_frame_stamp_us = f.stamp_us;
     handle(f, clock_.now_us());
     new_samples += static_cast<int>(stats_.positions[0] + stats_.positions[1] - before);
   }
   const std::int64_t now = clock_.now_us();
   produce_sync(now);
+  // Frames received long before this read (a backlog) are judged at their own stamps.
+  const bool backlog = newest_frame_stamp_us > 0 && now - newest_frame_stamp_us > options_.position_timeout_us;
   for (auto& w : wheels_) {
-    if (w.evaluate(now, options_.position_timeout_us, options_.heartbeat_timeout_us,
-                   supervision_start_us_)) {
+    if (backlog) {
+      w.evaluate_at_stamp(newest_frame_stamp_us, options_.position_timeout_us);
+    } else if (w.evaluate(now, options_.position_timeout_us, options_.heartbeat_timeout_us,
+                          supervision_start_us_)) {
       stats_.heartbeat_timeouts++;
     }
   }

@@ -84,6 +84,8 @@ struct DaemonIo {
 class Daemon {
  public:
   static constexpr std::size_t kLatencyWindow = 4096U;
+  // Frames read (one encoder update each) per odometry update at the most.
+  static constexpr std::uint32_t kMaxFramesPerOdometryUpdate = 512U;
 
   Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log);
   // Creates the output directory. False (with *error) iff that fails.
@@ -111,6 +113,7 @@ class Daemon {
     std::int64_t read_us = 0;  // when the driver handed it out
   };
   void update_odometry();
+  void take_odometry(const hal::OdometryReading& r);
   void enqueue(std::int64_t now_us);
   void place_scans(std::int64_t now_us, bool final_pass);
   void watch_faults();

@@ -45,6 +45,17 @@ struct WheelTracker {
     ticks.stale = position_late || heartbeat_lost || !node_ok;
     return newly_lost;
   }
+
+  // Staleness while draining a backlog: the frames handled were received (kernel stamp)
+  // long before they were read, e.g. while the host was busy. Freshness is then judged
+  // as of the newest frame's receive stamp, so that reading a backlog frame by frame
+  // does not make the wheel whose frame comes next look stale. Heartbeat loss is not
+  // decided from a backlog.
+  void evaluate_at_stamp(std::int64_t newest_frame_stamp_us, std::int64_t position_timeout_us) {
+    const bool position_late =
+        !ticks.has_sample || newest_frame_stamp_us - ticks.stamp_us > position_timeout_us;
+    ticks.stale = position_late || heartbeat_lost || !node_ok;
+  }
 };
 
 }  // namespace sdpslam::drivers::internal
