@@ -37,7 +37,7 @@ struct SdpOptions {
   // bottom filter's best submap (the others sample it from the PGS), [0, 1].
   double follow_best_fraction = 0.25;
   std::uint32_t rounds_per_segment = 3U;    // evaluation rounds after a segmentation, >= 1
-  std::uint32_t evaluations_per_scan = 3U;  // particles evaluated per scan (time budget), >= 1
+  std::uint32_t evaluations_per_scan = 2U;  // particles evaluated per scan (time budget), >= 1
   std::uint32_t max_pairs_per_sample = 6U;  // overlapping submap pairs matched per sample, >= 1
   double overlap_margin_m = 0.0;            // bounding boxes grown by this before the test
   double min_overlap_m2 = 4.0;              // pairs whose boxes share less area are ignored
