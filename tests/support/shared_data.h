@@ -13,7 +13,9 @@ std::string shared_path(const std::string& relative);
 // Same lookup without exiting: empty string when absent.
 std::string find_shared(const std::string& relative);
 
-// A fresh, empty temporary directory for one test's outputs.
+// A fresh, empty temporary directory for one test's outputs under $TMPDIR (or /tmp).
+// It and its contents are removed when the test program exits normally, unless
+// SDPSLAM_KEEP_TEST_DIRS is set in the environment.
 std::string make_temp_dir(const std::string& tag);
 
 }  // namespace sdpslam::test
