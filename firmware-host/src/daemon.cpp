@@ -38,10 +38,11 @@ std::string fmt_ms(double v) {
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log)
-    : config_(config), io_(io), log_(log), odom_(*io.encoders, config.drive) {}
+    : config_(config), io_(io), log_(log), paired_(*io.encoders), odom_(paired_, config.drive) {}
 
 bool Daemon::start(std::string* error) {
   if (!io::make_directories(config_.output_directory, error)) return false;
+  if (config_.input_log && !recorder_.open(config_.output_directory + "/input.clf", error)) return false;
   start_us_ = io_.clock->now_us();
   next_output_us_ = start_us_ + config_.output_period_us;
   log_.log(Event::kStartup, "mode %s, laser %s on %s, encoders %s, outputs every %.1f s in %s", io_.engine->name(),
@@ -130,7 +131,12 @@ void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
     }
     const std::int64_t waited = now_us - p.read_us;
     if (waited > counters_.max_odometry_wait_us) counters_.max_odometry_wait_us = waited;
-    const EngineStep s = io_.engine->process(OdometrySample{p.scan.stamp_us, pose}, p.scan);
+    OdometrySample slam_odom;
+    if (!recorder_.pass(OdometrySample{p.scan.stamp_us, pose}, p.scan, p.read_us, &slam_odom, &slam_scan_)) {
+      log_.log(Event::kOutput, "%s (%" PRIu64 " failed lines in all)", recorder_.last_error().c_str(),
+               recorder_.stats().write_failures);
+    }
+    const EngineStep s = io_.engine->process(slam_odom, slam_scan_);
     ++counters_.scans_placed;
     if (s.processed) ++counters_.scans_processed;
     const std::int64_t done_us = io_.clock->now_us();
@@ -306,7 +312,7 @@ std::string Daemon::status_json() const {
         lat(latency_from_read()) + ", \"max_odometry_wait\": " +
         fmt_ms(static_cast<double>(c.max_odometry_wait_us) / 1000.0) + "},\n";
   js += "  \"odometry\": {\"samples\": " + u(c.odometry_samples) + ", \"stale_events\": " + u(c.odometry_stale_events) +
-        ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
+        ", \"wheel_pairs\": " + u(paired_.pairs_published()) + ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
         ", \"x_m\": " + fmt_ms(od.pose.x_m) + ", \"y_m\": " + fmt_ms(od.pose.y_m) + ", \"heading_rad\": " +
         fmt_ms(od.pose.heading_rad) + "},\n";
   js += "  \"laser\": {\"scans\": " + u(ls.scan_count) + ", \"rejected\": " + u(ls.dropped_scan_count) +
@@ -325,6 +331,11 @@ std::string Daemon::status_json() const {
           ", \"bus_off\": " + u(cs.errors.bus_off) + ", \"down_count\": " + u(cs.down_count) +
           ", \"reopen_count\": " + u(cs.reopen_count) + ", \"tx_errors\": " + u(cs.tx_errors) + "},\n";
   }
+  const InputRecorderStats& rs = recorder_.stats();
+  js += "  \"input_log\": {\"enabled\": " + std::string(recorder_.is_open() ? "true" : "false") + ", \"lines\": " +
+        u(rs.lines_written) + ", \"bytes\": " + u(rs.bytes_written) + ", \"write_failures\": " +
+        u(rs.write_failures) + ", \"roundtrip_changed\": " + u(rs.changed_count) + ", \"roundtrip_failures\": " +
+        u(rs.roundtrip_failures) + "},\n";
   js += "  \"engine\": {" + io_.engine->status_json() + "},\n";
   js += "  \"outputs\": {\"writes\": " + u(c.output_writes) + ", \"failures\": " + u(c.output_failures) +
         ", \"max_write_ms\": " + fmt_ms(static_cast<double>(c.max_output_write_us) / 1000.0) + "},\n";

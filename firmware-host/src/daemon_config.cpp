@@ -313,6 +313,7 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       return R::kOk;
     }
     if (key == "write_map") return ok(boolean(v, &c.write_map, why));
+    if (key == "input_log") return ok(boolean(v, &c.input_log, why));
   } else if (sec == "daemon") {
     if (key == "log_interval_s") {
       if (!real_in(v, 0.0, 3600.0, false, &d, why)) return R::kBad;

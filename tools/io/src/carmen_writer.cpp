@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "log_parse.h"
 #include "sdpslam/io/atomic_file.h"
@@ -37,16 +38,10 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
-}  // namespace
-
-struct CarmenWriter::Impl {
-  AtomicOutputFile file;
-  bool open = false;
+// One line being formatted.
+struct LineBuilder {
   std::string line;
 
-  void put(const std::string& s) {
-    if (open) std::fputs(s.c_str(), file.stream());
-  }
   void num(double v) {
     line += detail::format_exact(v);
     line += ' ';
@@ -77,7 +72,51 @@ struct CarmenWriter::Impl {
     line += ' ';
     line += detail::format_stamp(logger_us);
     line += '\n';
-    put(line);
+  }
+};
+
+}  // namespace
+
+std::string format_carmen_laser_line(const LaserRecord& r) {
+  LineBuilder s;
+  const RangeScan& scan = r.scan;
+  const ScanGeometry& g = scan.geometry;
+  // Robot (odometry) pose and laser pose, each derived from the other when missing.
+  Pose2 robot = r.odom_pose;
+  Pose2 laser_pose = r.laser_pose;
+  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
+  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
+  const std::uint32_t n = scan.beam_count <= capacity::kMaxBeams ? scan.beam_count : capacity::kMaxBeams;
+
+  if (fits_flaser(r)) {
+    s.line = "FLASER " + std::to_string(n) + " ";
+    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
+    s.pose(laser_pose);
+    s.pose(robot);
+  } else {
+    s.line = "ROBOTLASER1 0 ";
+    s.numf(g.angle_min_rad);
+    s.numf(g.angle_increment_rad * static_cast<float>(n > 0U ? n - 1U : 0U));  // field of view
+    s.numf(g.angle_increment_rad);
+    s.numf(g.range_max_m);
+    s.num(0.0);  // accuracy
+    s.line += "0 " + std::to_string(n) + " ";  // remission_mode, num_readings
+    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
+    s.line += "0 ";  // num_remissions
+    s.pose(laser_pose);
+    s.pose(robot);
+    s.line += "0 0 0 0 0 ";  // tv rv forward_safety_dist side_safety_dist turn_axis
+  }
+  s.trailer(r.stamp_us, r.logger_stamp_us);
+  return std::move(s.line);
+}
+
+struct CarmenWriter::Impl {
+  AtomicOutputFile file;
+  bool open = false;
+
+  void put(const std::string& s) {
+    if (open) std::fputs(s.c_str(), file.stream());
   }
 };
 
@@ -109,47 +148,17 @@ void CarmenWriter::param(const std::string& name, const std::string& value) {
 }
 
 void CarmenWriter::odom(const OdomRecord& r) {
-  Impl& s = *impl_;
+  LineBuilder s;
   s.line = "ODOM ";
   s.pose(r.pose);
   s.num(r.tv_mps);
   s.num(r.rv_radps);
   s.num(0.0);  // accel
   s.trailer(r.stamp_us, r.logger_stamp_us);
+  impl_->put(s.line);
 }
 
-void CarmenWriter::laser(const LaserRecord& r) {
-  Impl& s = *impl_;
-  const RangeScan& scan = r.scan;
-  const ScanGeometry& g = scan.geometry;
-  // Robot (odometry) pose and laser pose, each derived from the other when missing.
-  Pose2 robot = r.odom_pose;
-  Pose2 laser_pose = r.laser_pose;
-  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
-  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
-  const std::uint32_t n = scan.beam_count <= capacity::kMaxBeams ? scan.beam_count : capacity::kMaxBeams;
-
-  if (fits_flaser(r)) {
-    s.line = "FLASER " + std::to_string(n) + " ";
-    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
-    s.pose(laser_pose);
-    s.pose(robot);
-  } else {
-    s.line = "ROBOTLASER1 0 ";
-    s.numf(g.angle_min_rad);
-    s.numf(g.angle_increment_rad * static_cast<float>(n > 0U ? n - 1U : 0U));  // field of view
-    s.numf(g.angle_increment_rad);
-    s.numf(g.range_max_m);
-    s.num(0.0);  // accuracy
-    s.line += "0 " + std::to_string(n) + " ";  // remission_mode, num_readings
-    for (std::uint32_t i = 0; i < n; ++i) s.range(scan.ranges_m[i], g.range_max_m);
-    s.line += "0 ";  // num_remissions
-    s.pose(laser_pose);
-    s.pose(robot);
-    s.line += "0 0 0 0 0 ";  // tv rv forward_safety_dist side_safety_dist turn_axis
-  }
-  s.trailer(r.stamp_us, r.logger_stamp_us);
-}
+void CarmenWriter::laser(const LaserRecord& r) { impl_->put(format_carmen_laser_line(r)); }
 
 bool CarmenWriter::close(std::string* error) {
   Impl& s = *impl_;

@@ -2,7 +2,8 @@
 // The onboard loop of sdpslamd: one thread, one monotonic clock.
 //
 // Each step():
-//   1. drains the CAN bus through the wheel encoders and the diff-drive odometry
+//   1. drains the CAN bus frame by frame through the wheel encoders, paired
+//      (PairedWheelEncoders), and the diff-drive odometry
 //      (drivers::EncoderOdometrySource) and appends every new valid pose to the
 //      OdometryRing; a stale encoder marks a break (no motion is ever invented across it);
 //   2. waits for the laser at most loop_slice_us (less while a scan waits for odometry);
@@ -12,7 +13,8 @@
 //      odometry_wait_us for the encoders to catch up, then is skipped and counted; one
 //      older than the ring, or whose bracketing samples straddle a break or a gap longer
 //      than max_interpolation_gap_us, is skipped and counted;
-//   4. feeds placed scans to the SlamEngine and records the latency: pose available minus
+//   4. feeds placed scans to the SlamEngine (as their CARMEN line reads back, and appends
+//      that line to <output>/input.clf when [output] input_log is on: InputRecorder) and records the latency: pose available minus
 //      the scan's stamp (for SCIP the sensor's stamp mapped onto our clock, ≈ its last
 //      byte's arrival on an idle line) and minus the moment the driver returned it;
 //   5. watches the sensors' counters and states and logs every change (EventLog);
@@ -32,7 +34,9 @@
 #include "sdpslam/core/ring_buffer.h"
 #include "sdpslam/daemon/daemon_config.h"
 #include "sdpslam/daemon/event_log.h"
+#include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/odometry_ring.h"
+#include "sdpslam/daemon/paired_wheel_encoders.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/hal/byte_stream.h"
@@ -88,7 +92,8 @@ class Daemon {
   static constexpr std::uint32_t kMaxFramesPerOdometryUpdate = 512U;
 
   Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log);
-  // Creates the output directory. False (with *error) iff that fails.
+  // Creates the output directory (and the input recording if enabled). False (with
+  // *error) iff that fails.
   bool start(std::string* error);
   void step();
   // Steps until *stop != 0, then finishes (see header). Returns true iff the final
@@ -103,6 +108,7 @@ class Daemon {
   LatencyFigures latency_from_stamp() const { return figures(stamp_latency_, stamp_latency_max_us_, latency_count_); }
   LatencyFigures latency_from_read() const { return figures(read_latency_, read_latency_max_us_, latency_count_); }
   const OdometryRing& odometry_ring() const { return ring_; }
+  const InputRecorder& input_recorder() const { return recorder_; }
   const hal::OdometryReading odometry() const { return odom_.latest(); }
   std::string status_json() const;
   std::size_t queued_scans() const { return queue_.size(); }
@@ -123,10 +129,13 @@ class Daemon {
   DaemonConfig config_;
   DaemonIo io_;
   EventLog& log_;
+  PairedWheelEncoders paired_;  // odometry steps on complete wheel pairs only (see its header)
   drivers::EncoderOdometrySource odom_;
   OdometryRing ring_;
   RingBuffer<PendingScan, DaemonConfig::kMaxScanQueue> queue_;
   RangeScan scratch_;
+  InputRecorder recorder_;
+  RangeScan slam_scan_;  // the placed scan as SLAM gets it (InputRecorder::pass)
   PendingScan pending_scratch_;
   DaemonCounters counters_;
   RingBuffer<std::int32_t, kLatencyWindow> stamp_latency_;

@@ -9,7 +9,7 @@
 //   [slam]    mode (dpslam | sdp) and seed; the filter's own sections [filter] [motion]
 //             [observation] [map] [capacity] [log] are the offline runner's
 //             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
-//   [output]  directory, write period, trajectory capacity
+//   [output]  directory, write period, trajectory capacity, map, input recording
 //   [daemon]  event-log rate limit, loop slice
 // Unknown sections and keys, malformed and out-of-range values are rejected as
 // "file:line: reason"; keys left out keep their defaults.
@@ -58,6 +58,7 @@ struct DaemonConfig {
   std::int64_t output_period_us = 5000000;
   std::uint32_t max_trajectory_scans = 200000U;
   bool write_map = true;
+  bool input_log = false;                    // stream every scan fed to SLAM to <directory>/input.clf
   // [daemon]
   std::int64_t log_interval_us = 1000000;    // one line per event kind at most this often
   std::int64_t loop_slice_us = 5000;         // longest wait on the laser before CAN is read

@@ -11,6 +11,10 @@
 
 namespace sdpslam::io {
 
+// The line CarmenWriter::laser() writes for `r` (FLASER or ROBOTLASER1, '\n' included),
+// for programs that stream a log line by line instead of writing it atomically.
+std::string format_carmen_laser_line(const LaserRecord& r);
+
 class CarmenWriter {
  public:
   CarmenWriter();
