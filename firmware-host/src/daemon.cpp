@@ -38,7 +38,10 @@ std::string fmt_ms(double v) {
 }  // namespace
 
 Daemon::Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log)
-    : config_(config), io_(io), log_(log), paired_(*io.encoders), odom_(paired_, config.drive) {}
+    : config_(config), io_(io), log_(log), paired_(*io.encoders, io.bus,
+              config.encoders.protocol == drivers::EncoderProtocol::kCanOpen ? config.encoders.canopen.position_timeout_us
+                                                                             : config.encoders.odrive.position_timeout_us),
+      odom_(paired_, config.drive) {}
 
 bool Daemon::start(std::string* error) {
   if (!io::make_directories(config_.output_directory, error)) return false;
@@ -312,7 +315,7 @@ std::string Daemon::status_json() const {
         lat(latency_from_read()) + ", \"max_odometry_wait\": " +
         fmt_ms(static_cast<double>(c.max_odometry_wait_us) / 1000.0) + "},\n";
   js += "  \"odometry\": {\"samples\": " + u(c.odometry_samples) + ", \"stale_events\": " + u(c.odometry_stale_events) +
-        ", \"wheel_pairs\": " + u(paired_.pairs_published()) + ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
+        ", \"wheel_pairs\": " + u(paired_.pairs_published()) + ", \"drain_stale_overrides\": " + u(paired_.drain_stale_overrides()) + ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
         ", \"x_m\": " + fmt_ms(od.pose.x_m) + ", \"y_m\": " + fmt_ms(od.pose.y_m) + ", \"heading_rad\": " +
         fmt_ms(od.pose.heading_rad) + "},\n";
   js += "  \"laser\": {\"scans\": " + u(ls.scan_count) + ", \"rejected\": " + u(ls.dropped_scan_count) +

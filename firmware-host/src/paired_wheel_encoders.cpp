@@ -12,8 +12,21 @@ int PairedWheelEncoders::update() {
     published_ = s;
     ++pairs_;
   }
-  published_.left.stale = s.left.stale;
-  published_.right.stale = s.right.stale;
+  bool left_stale = s.left.stale;
+  bool right_stale = s.right.stale;
+  if ((left_stale || right_stale) && bus_ != nullptr && bus_->wait_readable(0) > 0) {
+    const std::int64_t newest = s.left.stamp_us > s.right.stamp_us ? s.left.stamp_us : s.right.stamp_us;
+    auto stamp_fresh = [&](const hal::WheelTicks& w) {
+      return w.has_sample && newest - w.stamp_us <= position_timeout_us_;
+    };
+    const bool l = left_stale && stamp_fresh(s.left);
+    const bool rr = right_stale && stamp_fresh(s.right);
+    if (l) left_stale = false;
+    if (rr) right_stale = false;
+    if (l || rr) ++overrides_;
+  }
+  published_.left.stale = left_stale;
+  published_.right.stale = right_stale;
   return r;
 }
 

@@ -1,7 +1,9 @@
 # Runs inside the virtual-CAN machine (tests/hil/run_in_vm.sh): the unmodified sdpslamd
 # (static) reads encoder frames from vcan0 and the emulated URG on a pty, while the player
 # replays the log on both at SPEED; SIGTERM at the end, then the outputs are printed
-# between markers for the host to compare. Arguments: LINES SPEED
+# between markers for the host to compare: the daemon's log, status.json as text, and the
+# output directory (trajectory.txt, map.pgm, input.clf, ...) as a base64 tar.gz so the
+# host gets every byte. Arguments: LINES SPEED
 lines=$1
 speed=$2
 ip link add dev vcan0 type vcan && ip link set up vcan0 || exit 10
@@ -21,8 +23,8 @@ daemon_rc=$?
 cat /tmp/daemon.log
 echo "@@STATUS"
 cat /tmp/out/status.json
-echo "@@TRAJECTORY"
-cat /tmp/out/trajectory.txt
+echo "@@OUTPUTS"
+( cd /tmp/out && tar cf - . ) | gzip -c | base64
 echo "@@END"
 ls /tmp/out | grep -q '\.tmp' && echo "temporary files left in /tmp/out" && daemon_rc=20
 echo "replay exit $replay_rc, sdpslamd exit $daemon_rc"
