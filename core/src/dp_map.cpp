@@ -26,7 +26,7 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   if (!std::isfinite(o.origin_x_m) || !std::isfinite(o.origin_y_m)) return false;
   if (!(o.resolution_m > 0.0) || !(o.width_m > 0.0) || !(o.height_m > 0.0)) return false;
   if (o.tile_capacity == 0U || o.tile_capacity > capacity::kDpMaxTiles || o.observation_capacity == 0U) return false;
-  if (o.observation_capacity >= 0xFFFFFFF0U) return false;
+  if (o.observation_capacity > (1U << 30U)) return false;  // index_slots_for() < 2^31
   d->width_cells = cells_for(o.width_m, o.resolution_m);
   d->height_cells = cells_for(o.height_m, o.resolution_m);
   if (d->width_cells <= 0 || d->height_cells <= 0) return false;
@@ -47,6 +47,13 @@ std::size_t pool_bytes(std::uint32_t capacity) {
 
 }  // namespace
 
+std::size_t DpMap::index_slots_for(std::uint32_t observation_capacity) {
+  const std::size_t want = static_cast<std::size_t>(observation_capacity) + observation_capacity / 2U + 1U;
+  std::size_t slots = 2U;
+  while (slots < want) slots <<= 1U;
+  return slots;
+}
+
 bool DpMap::options_valid(const Options& options) {
   GridDims d;
   return grid_dims(options, &d);
@@ -56,7 +63,8 @@ std::size_t DpMap::required_arena_bytes(const Options& options, std::uint32_t no
   GridDims d;
   if (!grid_dims(options, &d)) return 0U;
   return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + kOwnerTables * node_capacity) +
-         2U * alignof(std::uint32_t) + pool_bytes<Tile>(options.tile_capacity) +
+         3U * alignof(std::uint32_t) + sizeof(std::uint32_t) * index_slots_for(options.observation_capacity) +
+         pool_bytes<Tile>(options.tile_capacity) +
          pool_bytes<Observation>(options.observation_capacity);
 }
 
@@ -68,7 +76,14 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   tile_table_ = arena.allocate_array<std::uint32_t>(table_entries);
   const std::size_t cap = tree.capacity();
   std::uint32_t* owners = arena.allocate_array<std::uint32_t>(kOwnerTables * cap);
-  if (tile_table_ == nullptr || owners == nullptr) return false;
+  const std::size_t slots = index_slots_for(options.observation_capacity);
+  index_ = arena.allocate_array<std::uint32_t>(slots);
+  if (tile_table_ == nullptr || owners == nullptr || index_ == nullptr) return false;
+  for (std::size_t i = 0; i < slots; ++i) index_[i] = kNone;
+  index_mask_ = static_cast<std::uint32_t>(slots - 1U);
+  std::uint32_t bits = 0U;
+  while ((std::size_t{1} << bits) < slots) ++bits;
+  index_shift_ = 64U - bits;
   owner_node_ = owners;
   node_owner_ = owners + cap;
   owner_head_ = owners + 2U * cap;
@@ -117,11 +132,52 @@ void DpMap::cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y
   *y_m = options_.origin_y_m + (static_cast<double>(iy) + 0.5) * options_.resolution_m;
 }
 
-std::uint32_t DpMap::find_in_cell(std::uint32_t first, std::uint32_t owner) const {
-  for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
-    if (obs_[e].owner == owner) return e;
+std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_t c) const {
+  std::uint32_t e = tiles_[slot].head[c];
+  if (e == kNone) return kNone;
+  const std::uint32_t location = (slot << (2U * kSideLog2)) | c;
+  // Entries of live nodes only (invariant), so the unchecked query is safe.
+  const AncestryTree::DescendantQuery query(*tree_, particle);
+  NodeId up = particle;  // next ancestor-or-self whose index entry is probed
+  for (;;) {
+    const Observation& o = obs_[e];
+    const NodeId node = owner_node_[o.owner];
+    if (node == particle || query.has_ancestor_or_self(node)) return e;
+    e = o.next_in_cell;
+    if (e == kNone) return kNone;  // the list is exhausted: no ancestor-or-self here
+    if (up == kNoNode) return kNone;  // every ancestor was probed: none has an entry
+    const std::uint32_t owner = node_owner_[up];
+    if (owner != kNone) {
+      const std::uint32_t f = index_find(owner, location);
+      if (f != kNone) return f;
+    }
+    up = tree_->parent(up);
   }
-  return kNone;
+}
+
+void DpMap::index_insert(std::uint32_t e) {
+  std::uint32_t i = index_home(obs_[e].owner, obs_[e].location);
+  while (index_[i] != kNone) i = (i + 1U) & index_mask_;
+  index_[i] = e;
+}
+
+// Backward-shift deletion (linear probing without tombstones): later members of the
+// probe run move into the hole unless their home lies cyclically in (hole, position].
+void DpMap::index_erase(std::uint32_t e) {
+  std::uint32_t i = index_home(obs_[e].owner, obs_[e].location);
+  while (index_[i] != e) i = (i + 1U) & index_mask_;
+  std::uint32_t j = i;
+  for (;;) {
+    j = (j + 1U) & index_mask_;
+    const std::uint32_t f = index_[j];
+    if (f == kNone) break;
+    const std::uint32_t k = index_home(obs_[f].owner, obs_[f].location);
+    const bool stays = i <= j ? (i < k && k <= j) : (i < k || k <= j);
+    if (stays) continue;
+    index_[i] = f;
+    i = j;
+  }
+  index_[i] = kNone;
 }
 
 void DpMap::release_owner(std::uint32_t owner) {
@@ -146,7 +202,7 @@ bool DpMap::update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObserv
   const std::uint32_t slot = tile_table_[ti];
   const std::uint32_t owner = node_owner_[particle];
   if (slot != kNone && owner != kNone) {
-    const std::uint32_t e = find_in_cell(tiles_[slot].head[c], owner);
+    const std::uint32_t e = index_find(owner, (slot << (2U * kSideLog2)) | c);
     if (e != kNone) {
       obs_[e].value = value;
       return true;
@@ -203,14 +259,22 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
   o->location = (slot << (2U * kSideLog2)) | c;
   // Keep descendants before ancestors: a leaf goes first; an inner node goes after the
   // last entry of any of its descendants.
-  std::uint32_t* link = &tile.head[c];
+  std::uint32_t prev = kNone;
   if (tree_->child_count(particle) > 0U) {
-    for (std::uint32_t* l = link; *l != kNone; l = &obs_[*l].next_in_cell) {
-      if (tree_->is_ancestor_or_self(particle, owner_node_[obs_[*l].owner])) link = &obs_[*l].next_in_cell;
+    for (std::uint32_t f = tile.head[c]; f != kNone; f = obs_[f].next_in_cell) {
+      if (tree_->is_ancestor_or_self(particle, owner_node_[obs_[f].owner])) prev = f;
     }
   }
-  o->next_in_cell = *link;
-  *link = e;
+  const std::uint32_t next = prev == kNone ? tile.head[c] : obs_[prev].next_in_cell;
+  o->prev_in_cell = prev;
+  o->next_in_cell = next;
+  if (prev == kNone) {
+    tile.head[c] = e;
+  } else {
+    obs_[prev].next_in_cell = e;
+  }
+  if (next != kNone) obs_[next].prev_in_cell = e;
+  index_insert(e);
   o->next_in_node = owner_head_[owner];
   owner_head_[owner] = e;
   ++owner_count_[owner];
@@ -218,9 +282,10 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
   return true;
 }
 
-// One scan instead of lookup() + update(): the first entry of `particle` or of an
-// ancestor is its view; if it is the particle's own, it is updated in place, otherwise
-// the particle has none in this cell (its own would come first) and a new one is made.
+// One find_view() instead of lookup() + update(): the deepest entry of `particle` or of
+// an ancestor is its view; if it is the particle's own, it is updated in place,
+// otherwise the particle has none in this cell (its own would be the deepest) and a new
+// one is made.
 bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
   if (tree_ == nullptr || !tree_->contains(particle)) {
     ++misuse_count_;
@@ -235,32 +300,31 @@ bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t
   const std::uint32_t slot = tile_table_[ti];
   CellObservation view{};
   if (slot != kNone) {
-    const AncestryTree::DescendantQuery query(*tree_, particle);
-    for (std::uint32_t e = tiles_[slot].head[c]; e != kNone; e = obs_[e].next_in_cell) {
+    const std::uint32_t e = find_view(particle, slot, c);
+    if (e != kNone) {
       Observation& o = obs_[e];
-      const NodeId node = owner_node_[o.owner];
-      if (node == particle) {
+      if (owner_node_[o.owner] == particle) {
         o.value = accumulate(o.value, hits, misses);
         return true;
       }
-      if (query.has_ancestor_or_self(node)) {
-        view = o.value;
-        break;
-      }
+      view = o.value;
     }
   }
   return insert(particle, ti, c, accumulate(view, hits, misses));
 }
 
 void DpMap::unlink_from_cell(std::uint32_t e) {
-  const std::uint32_t loc = obs_[e].location;
-  Tile& tile = tiles_[loc >> (2U * kSideLog2)];
-  std::uint32_t* link = &tile.head[loc & (capacity::kDpTileCells - 1U)];
-  while (*link != kNone && *link != e) link = &obs_[*link].next_in_cell;
-  if (*link == e) *link = obs_[e].next_in_cell;
+  const Observation& o = obs_[e];
+  if (o.prev_in_cell == kNone) {
+    tiles_[o.location >> (2U * kSideLog2)].head[o.location & (capacity::kDpTileCells - 1U)] = o.next_in_cell;
+  } else {
+    obs_[o.prev_in_cell].next_in_cell = o.next_in_cell;
+  }
+  if (o.next_in_cell != kNone) obs_[o.next_in_cell].prev_in_cell = o.prev_in_cell;
 }
 
 void DpMap::release_observation(std::uint32_t e) {
+  index_erase(e);
   unlink_from_cell(e);
   const std::uint32_t slot = obs_[e].location >> (2U * kSideLog2);
   Tile& tile = tiles_[slot];
@@ -309,13 +373,14 @@ void DpMap::merge_node(NodeId parent, NodeId child) {
       while (e != kNone) {
         Observation& o = obs_[e];
         const std::uint32_t next = o.next_in_node;
-        // P's entry in this cell, if any, follows C's.
-        const std::uint32_t f = find_in_cell(o.next_in_cell, op);
+        const std::uint32_t f = index_find(op, o.location);  // P's entry in this cell
         if (f != kNone) {
           obs_[f].value = o.value;  // C's record is newer: it survives in P's slot
           release_observation(e);   // the tile keeps f, so it stays
         } else {
+          index_erase(e);
           o.owner = op;
+          index_insert(e);
           o.next_in_node = owner_head_[op];
           owner_head_[op] = e;
           ++owner_count_[op];
@@ -335,12 +400,12 @@ void DpMap::merge_node(NodeId parent, NodeId child) {
   while (e != kNone) {
     Observation& o = obs_[e];
     const std::uint32_t next = o.next_in_node;
-    const std::uint32_t loc = o.location;
-    const std::uint32_t head = tiles_[loc >> (2U * kSideLog2)].head[loc & (capacity::kDpTileCells - 1U)];
-    if (find_in_cell(head, oc) != kNone) {
+    if (index_find(oc, o.location) != kNone) {
       release_observation(e);  // the child's own record is newer and shadows it
     } else {
+      index_erase(e);
       o.owner = oc;
+      index_insert(e);
       o.next_in_node = owner_head_[oc];
       owner_head_[oc] = e;
       ++owner_count_[oc];
@@ -408,7 +473,8 @@ std::uint32_t DpMap::observation_count(NodeId node) const {
 }
 
 std::size_t DpMap::footprint_bytes() const {
-  return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + kOwnerTables * node_capacity_) +
+  return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + kOwnerTables * node_capacity_ +
+                                  static_cast<std::size_t>(index_mask_) + 1U) +
          tiles_pool_.footprint_bytes() + obs_pool_.footprint_bytes();
 }
 
@@ -430,10 +496,13 @@ bool DpMap::invariants_hold() const {
     if (tile.table_index != t || tile.count == 0U) return false;
     std::uint32_t in_tile = 0U;
     for (std::uint32_t c = 0U; c < capacity::kDpTileCells; ++c) {
-      for (std::uint32_t e = tile.head[c]; e != kNone; e = obs_[e].next_in_cell) {
+      std::uint32_t prev = kNone;
+      for (std::uint32_t e = tile.head[c]; e != kNone; prev = e, e = obs_[e].next_in_cell) {
         if (!obs_pool_.slot_in_use(e) || ++in_cells > obs_total) return false;
         ++in_tile;
         const Observation& o = obs_[e];
+        if (o.prev_in_cell != prev) return false;
+        if (index_find(o.owner, o.location) != e) return false;
         if (o.location != ((slot << (2U * kSideLog2)) | c) || o.owner >= node_capacity_) return false;
         const NodeId node = owner_node_[o.owner];
         if (!tree_->contains(node)) return false;
@@ -446,6 +515,14 @@ bool DpMap::invariants_hold() const {
     if (in_tile != tile.count) return false;
   }
   if (tiles_seen != tiles_pool_.size() || in_cells != obs_total) return false;
+  // Index: exactly one slot per observation (each findable, checked above).
+  std::uint32_t indexed = 0U;
+  for (std::size_t i = 0U; i <= index_mask_; ++i) {
+    const std::uint32_t e = index_[i];
+    if (e == kNone) continue;
+    if (!obs_pool_.slot_in_use(e) || ++indexed > obs_total) return false;
+  }
+  if (indexed != obs_total) return false;
   // Owners: the free stack holds distinct owners not in use; an owner in use (not on
   // the stack) belongs to a live node that points back at it, has a non-empty list of
   // its own entries whose length is its count; lists add up to the pool count.

@@ -122,7 +122,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   // stats.json: deterministic fields first, timing apart.
   const AncestryTree& tree = filter->tree();
   const DpSlamStats& st = filter->stats();
-  constexpr std::size_t kObservationBytes = 20U;  // DpMap::Observation (static_assert there)
+  constexpr std::size_t kObservationBytes = DpMap::kObservationBytes;
   constexpr std::size_t kTileBytes = (capacity::kDpTileCells + 2U) * sizeof(std::uint32_t);
   constexpr std::size_t kPathEntryBytes = 40U;    // stamp + Pose2 + link, padded
   const std::size_t node_bytes = tree.capacity() > 0U ? (tree.footprint_bytes() - tree.path_entry_capacity() * kPathEntryBytes) / tree.capacity() : 0U;

@@ -12,20 +12,32 @@
 //  - a tile index table, one u32 per tile of kDpTileSideCells² cells, covering the area;
 //  - tiles (cell list heads) from a pool, allocated on the first write into the tile and
 //    released when their last observation goes, so unexplored space costs 4 bytes/tile;
-//  - observations (20 bytes: owner, cell link, owner link, cell address, value) from a
-//    pool. An observation names an *owner* slot, not a node: owner → node and
+//  - observations (24 bytes: owner, cell links both ways, owner link, cell address,
+//    value) from a pool; the cell list is doubly linked so that a release is O(1). An observation names an *owner* slot, not a node: owner → node and
 //    node → owner tables (one owner per node that has observations, sized by the tree's
 //    capacity) add one indirection to lookups and make a merge cost O(smaller side).
 //    Each owner keeps an intrusive list of its observations and their count;
-//  - owner tables: owner → node, node → owner, list head, count, free-owner stack.
+//  - owner tables: owner → node, node → owner, list head, count, free-owner stack;
+//  - an (owner, cell) → observation index: open addressing with linear probing and
+//    backward-shift deletion, 4 bytes per slot, the smallest power of two ≥ 1.5 ×
+//    observation_capacity slots (load ≤ 2/3 even with the pool full).
+//
+// Finding a particle's view in a cell (the hot path of every map update and beam
+// evaluation) runs two exact searches in lockstep and stops with whichever ends first:
+// the scan of the cell list (the first ancestor-or-self entry is the deepest, see
+// update()) and the walk up the particle's ancestors probing the index for each one's
+// entry in this cell (the first found is the deepest by construction). With N
+// particles a busy cell holds an entry per live lineage, so the scan alone costs O(N)
+// cache misses per cell, while the nearest ancestor with an entry is usually the
+// particle itself or its parent: cost O(min(list position, ancestor distance)).
 //
 // Merge cost (TreeListener::on_node_merged, parent P into its only child C): if P owns
 // more observations than C, C's are moved into P's owner (where both have one in a
 // cell, C's newer value is copied into P's entry and C's is freed) and P's owner is
 // re-pointed to C; otherwise P's are moved into C's owner. Either way
 // O(min(|P|, |C|) × cell list length): a fresh particle (C empty) costs O(1) however
-// long the history it inherits. Removal costs O(observations of the node × cell list
-// length).
+// long the history it inherits; each moved or dropped entry costs O(1) expected (index).
+// Removal costs O(observations of the node) expected.
 //
 // Ownership: the map keeps a reference to the AncestryTree given to init() (it must
 // outlive the map) and reads it for ancestor queries; the tree tells the map about
@@ -97,7 +109,7 @@ class DpMap final : public TreeListener {
   static std::size_t required_arena_bytes(const Options& options, std::uint32_t node_capacity);
   // True iff the options describe a usable map: finite origin, width/height/resolution
   // > 0, cells per axis < 2^31 and the tile table < 2^32 entries, 1 ≤ tile_capacity ≤
-  // capacity::kDpMaxTiles, observation_capacity ≥ 1.
+  // capacity::kDpMaxTiles, 1 ≤ observation_capacity ≤ 2^30 (the index stays < 2^31 slots).
   static bool options_valid(const Options& options);
 
   // Validates `options`, keeps a reference to `tree` (initialised first: its capacity
@@ -123,14 +135,13 @@ class DpMap final : public TreeListener {
   // ---- the particle's view -----------------------------------------------------------
   // The observation of `particle`'s deepest ancestor-or-self that has one in cell
   // (ix, iy). False (and *out untouched) iff none has one, the cell is outside the map,
-  // or `particle` is dead. Cost: tile table → cell head → scan of that cell's list with
-  // an O(1) ancestor test per entry, stopping at the first ancestor-or-self (lists keep
-  // descendants first); no walk up the tree.
+  // or `particle` is dead. Cost: tile table → cell head → find_view() (the lockstep
+  // search described at the top of this file): O(min(list position, ancestor distance)).
   bool lookup(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation* out) const {
     if (!in_bounds(ix, iy)) return false;
     const std::uint32_t tile = tile_table_[tile_index(ix, iy)];
     if (tile == kNone) return false;
-    return resolve(particle, tiles_[tile].head[cell_in_tile(ix, iy)], out);
+    return resolve(particle, tile, cell_in_tile(ix, iy), out);
   }
 
   // Sets `particle`'s own observation of cell (ix, iy) to `value`: in place if it has
@@ -141,11 +152,12 @@ class DpMap final : public TreeListener {
   // dropped — the degraded path, after which the map is unchanged and consistent:
   // out of the area (out_of_bounds_count), a tile is needed and none is free
   // (tile_oom_count), an observation is needed and none is free (observation_oom_count),
-  // or `particle` is not a live tree node (misuse_count). O(cell list length).
+  // or `particle` is not a live tree node (misuse_count). O(1) expected for a leaf
+  // (index probe, insertion at the head), O(cell list length) for an inner node.
   bool update(NodeId particle, std::int32_t ix, std::int32_t iy, CellObservation value);
   // lookup() then accumulate() then update(): the particle's own record becomes its
-  // current view plus the new evidence. Same result and failure rules as update(), in
-  // one scan of the cell list that stops at the first ancestor-or-self entry.
+  // current view plus the new evidence. Same result and failure rules as update(), with
+  // one find_view() (whose answer, if the particle's own, is updated in place).
   bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
 
   // ---- extraction --------------------------------------------------------------------
@@ -177,6 +189,10 @@ class DpMap final : public TreeListener {
   void on_node_merged(NodeId parent, NodeId child) override { merge_node(parent, child); }
 
   // ---- accounting --------------------------------------------------------------------
+  // Bytes of one observation slot (the pool's entries, without the index share).
+  static constexpr std::size_t kObservationBytes = 24U;
+  // Slots of the (owner, cell) index for a given observation capacity (see the top).
+  static std::size_t index_slots_for(std::uint32_t observation_capacity);
   std::uint32_t tiles_used() const { return tiles_pool_.size(); }
   std::uint32_t tiles_peak() const { return tiles_pool_.peak_used(); }
   std::uint32_t tile_capacity() const { return tiles_pool_.capacity(); }
@@ -187,7 +203,7 @@ class DpMap final : public TreeListener {
   std::uint32_t observation_oom_count() const { return observation_oom_count_; }
   std::uint32_t out_of_bounds_count() const { return out_of_bounds_count_; }
   std::uint32_t misuse_count() const { return misuse_count_; }
-  // Bytes of state: tile table, tile pool, observation pool, owner tables.
+  // Bytes of state: tile table, tile pool, observation pool, owner tables, index.
   std::size_t footprint_bytes() const;
 
   // Full self-check, O(capacity): pool invariants; the owner tables are a bijection
@@ -196,7 +212,9 @@ class DpMap final : public TreeListener {
   // exactly the other owners; every observation is in exactly one cell list and one
   // owner list, and they agree on its owner and cell; no node has two
   // observations in one cell and no entry follows an entry of one of its ancestors
-  // (what lets lookups stop early); every node with observations is live in the tree; the
+  // (what lets lookups stop early); the backward cell links mirror the forward ones; the
+  // index holds exactly the observations, each findable by its (owner, cell) key;
+  // every node with observations is live in the tree; the
   // tile table and tile back-references agree; each tile's count equals its entries
   // and no tile in use is empty; list lengths add up to the pool counts.
   bool invariants_hold() const;
@@ -209,11 +227,12 @@ class DpMap final : public TreeListener {
   struct Observation {
     std::uint32_t owner;  // owner slot; owner_node_[owner] is the node it belongs to
     std::uint32_t next_in_cell;
+    std::uint32_t prev_in_cell;  // kNone at the head of the cell list
     std::uint32_t next_in_node;
     std::uint32_t location;  // (tile slot << 2k) | cell in tile
     CellObservation value;
   };
-  static_assert(sizeof(Observation) == 20U, "observation entries must stay compact");
+  static_assert(sizeof(Observation) == kObservationBytes, "observation entries must stay compact");
   struct Tile {
     std::uint32_t head[capacity::kDpTileCells];  // first observation per cell, kNone if empty
     std::uint32_t count;                         // observations in this tile
@@ -227,23 +246,38 @@ class DpMap final : public TreeListener {
     return ((static_cast<std::uint32_t>(iy) & kSideMask) << kSideLog2) | (static_cast<std::uint32_t>(ix) & kSideMask);
   }
 
-  // Deepest ancestor-or-self of `particle` among the list starting at `first`. Cell
-  // lists keep every node's entry before its ancestors' entries (see update()), so the
-  // first ancestor-or-self found is the deepest one.
-  bool resolve(NodeId particle, std::uint32_t first, CellObservation* out) const {
+  // Deepest ancestor-or-self of `particle` with an entry in cell `c` of tile slot `slot`.
+  bool resolve(NodeId particle, std::uint32_t slot, std::uint32_t c, CellObservation* out) const {
     if (!tree_->contains(particle)) return false;
-    // Entries of live nodes only (invariant), so the unchecked query is safe.
-    const AncestryTree::DescendantQuery query(*tree_, particle);
-    for (std::uint32_t e = first; e != kNone; e = obs_[e].next_in_cell) {
-      const Observation& o = obs_[e];
-      const NodeId node = owner_node_[o.owner];
-      if (node == particle || query.has_ancestor_or_self(node)) {
-        *out = o.value;
-        return true;
-      }
-    }
-    return false;
+    const std::uint32_t e = find_view(particle, slot, c);
+    if (e == kNone) return false;
+    *out = obs_[e].value;
+    return true;
   }
+  // Entry of `particle`'s (live) deepest ancestor-or-self in that cell, kNone if none:
+  // the lockstep of the cell-list scan (lists keep every node's entry before its
+  // ancestors' entries, see update(), so the first ancestor-or-self found is the
+  // deepest) and the ancestor walk probing the index; both exact, first to end wins.
+  std::uint32_t find_view(NodeId particle, std::uint32_t slot, std::uint32_t c) const;
+  // Home slot: a Fibonacci hash of (owner, tile) plus the cell in the tile times 4, so
+  // that the cells of one tile that a beam visits in a row probe nearby slots (a cache
+  // line holds 16) instead of a random line each, while a tile an owner has filled
+  // occupies at most a quarter of its 1024-slot window (linear probing stays short).
+  std::uint32_t index_home(std::uint32_t owner, std::uint32_t location) const {
+    const std::uint64_t key = (static_cast<std::uint64_t>(owner) << 32U) | (location >> (2U * kSideLog2));
+    const auto base = static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ULL) >> index_shift_);
+    return (base + ((location & (capacity::kDpTileCells - 1U)) << 2U)) & index_mask_;
+  }
+  // The observation of `owner` at `location`, kNone if none. O(1) expected.
+  std::uint32_t index_find(std::uint32_t owner, std::uint32_t location) const {
+    for (std::uint32_t i = index_home(owner, location);; i = (i + 1U) & index_mask_) {
+      const std::uint32_t e = index_[i];
+      if (e == kNone) return kNone;
+      if (obs_[e].owner == owner && obs_[e].location == location) return e;
+    }
+  }
+  void index_insert(std::uint32_t e);
+  void index_erase(std::uint32_t e);
   // New entry of `particle` (live, no entry in this cell yet) in cell `c` of tile-table
   // entry `ti`; the tail of update()/add() with their exhaustion rules.
   bool insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObservation value);
@@ -251,7 +285,6 @@ class DpMap final : public TreeListener {
   void merge_node(NodeId parent, NodeId child);
   void unlink_from_cell(std::uint32_t e);
   void release_observation(std::uint32_t e);
-  std::uint32_t find_in_cell(std::uint32_t first, std::uint32_t owner) const;
   void release_owner(std::uint32_t owner);
   void location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const;
 
@@ -277,6 +310,9 @@ class DpMap final : public TreeListener {
   std::uint32_t* owner_count_ = nullptr;
   std::uint32_t* owner_free_ = nullptr;  // stack of free owners, owner_free_count_ deep
   std::uint32_t owner_free_count_ = 0U;
+  std::uint32_t* index_ = nullptr;  // (owner, location) → observation, kNone = empty slot
+  std::uint32_t index_mask_ = 0U;   // slots − 1
+  std::uint32_t index_shift_ = 63U;  // 64 − log2(slots)
   std::uint32_t node_capacity_ = 0U;
   std::uint32_t touched_tx0_ = kNone, touched_ty0_ = kNone, touched_tx1_ = 0U, touched_ty1_ = 0U;
   std::uint32_t tile_oom_count_ = 0U;
@@ -295,7 +331,7 @@ void DpMap::for_each_known_cell(NodeId particle, F&& f) const {
     const std::int32_t ty0 = static_cast<std::int32_t>((t / tiles_x_) << kSideLog2);
     for (std::uint32_t c = 0U; c < capacity::kDpTileCells; ++c) {
       CellObservation v;
-      if (resolve(particle, tiles_[slot].head[c], &v)) {
+      if (resolve(particle, slot, c, &v)) {
         f(tx0 + static_cast<std::int32_t>(c & kSideMask), ty0 + static_cast<std::int32_t>(c >> kSideLog2),
           static_cast<const CellObservation&>(v));
       }
