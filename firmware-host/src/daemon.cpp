@@ -232,6 +232,7 @@ bool Daemon::run(const volatile std::sig_atomic_t* stop) {
 bool Daemon::finish() {
   update_odometry();
   place_scans(io_.clock->now_us(), true);
+  io_.engine->finish();
   return write_outputs();
 }
 

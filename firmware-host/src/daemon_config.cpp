@@ -1,6 +1,8 @@
 #include "sdpslam/daemon/daemon_config.h"
 
+#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/drivers/serial_port.h"
+#include "sdpslam/slam/run_sdp.h"
 
 #include <ini.h>
 
@@ -27,7 +29,7 @@ struct ParseState {
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
 bool known_section(const std::string& sec) {
-  static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "output", "daemon"};
+  static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "sdp", "output", "daemon"};
   for (const char* k : kOwn) {
     if (sec == k) return true;
   }
@@ -293,6 +295,14 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       c.seed = static_cast<std::uint64_t>(i);
       return R::kOk;
     }
+  } else if (sec == "sdp") {
+    // The offline runner's own [sdp] parser: same keys, values and ranges; its reasons
+    // already name "[sdp] key" or the option.
+    switch (slam::apply_sdp_key(&c.sdp, key, v, why)) {
+      case slam::SdpKeyResult::kApplied: return R::kOk;
+      case slam::SdpKeyResult::kInvalid: return R::kBad;
+      case slam::SdpKeyResult::kUnknown: return R::kUnknown;
+    }
   } else if (sec == "output") {
     if (key == "directory") {
       if (*v == '\0') {
@@ -349,7 +359,7 @@ int handler(void* user, const char* section, const char* name, const char* value
     const R r = handle_key(*st->config, sec, name, value, &why);
     if (r == R::kOk) return 1;
     if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
-    else if (!slam::is_slam_config_section(sec)) why = sec + "." + name + ": " + why;
+    else if (!slam::is_slam_config_section(sec) && sec != "sdp") why = sec + "." + name + ": " + why;
   }
   if (st->error.empty()) st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
   return 0;
@@ -389,6 +399,17 @@ bool load_daemon_config(const std::string& path, DaemonConfig* config, std::stri
   if (!config->slam.filter.validate(why, sizeof why)) {
     *error = at + why;
     return false;
+  }
+  if (config->mode == SlamMode::kSdp) {
+    if (!config->sdp.validate(why, sizeof why)) {
+      *error = at + "sdp: " + why;
+      return false;
+    }
+    // SDP-SLAM adds the pool room anchored segments need to the bottom options.
+    if (!SdpSlam::bottom_options_for(config->slam.filter, config->sdp).validate(why, sizeof why)) {
+      *error = at + "sdp: bottom level with the room for " + std::to_string(config->sdp.max_levels) + " levels: " + why;
+      return false;
+    }
   }
   return true;
 }

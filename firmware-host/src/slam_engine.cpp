@@ -2,6 +2,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::daemon {
@@ -87,12 +88,97 @@ class DpSlamEngine final : public SlamEngine {
   std::uint64_t unrecorded_ = 0U;
 };
 
+// Segmented DP-SLAM: the offline runner's SDP loop (tools/slam run_sdp.cpp) one scan at
+// a time, with its outputs built by the same functions (slam_outputs.h).
+class SdpEngine final : public SlamEngine {
+ public:
+  bool init(const DaemonConfig& c, std::string* error) {
+    const DpSlamOptions& fo = c.slam.filter;
+    char why[200];
+    if (!fo.validate(why, sizeof why) || !c.sdp.validate(why, sizeof why)) {
+      *error = std::string("invalid SLAM options: ") + why;
+      return false;
+    }
+    arena_bytes_ = SdpSlam::required_arena_bytes(fo, c.sdp);
+    if (arena_bytes_ == 0U) {
+      *error = "invalid SDP-SLAM options (arena size)";
+      return false;
+    }
+    buffer_.reset(new unsigned char[arena_bytes_]);
+    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
+    slam_ = std::make_unique<SdpSlam>();
+    if (!slam_->init(fo, c.sdp, *arena_, c.seed)) {
+      *error = std::string("SDP-SLAM init failed: ") + slam_->why();
+      return false;
+    }
+    permanent_.poses.reserve(c.max_trajectory_scans);
+    slam_->set_permanent_sink(&permanent_);
+    scans_.reserve(c.max_trajectory_scans);
+    return true;
+  }
+
+  const char* name() const override { return "sdp"; }
+
+  EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
+    const SdpStepResult r = slam_->process(odom, scan);
+    EngineStep s;
+    s.processed = r.bottom.status == StepResult::Status::kProcessed;
+    s.pose = r.pose;  // global frame, best top-level particle
+    if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
+    else ++unrecorded_;
+    return s;
+  }
+
+  std::vector<io::StampedPose> trajectory() const override {
+    return slam::assemble_trajectory(scans_, slam::sdp_best_path(*slam_, permanent_.poses), &path_gaps_);
+  }
+
+  std::uint32_t map_image(io::OccupancyImage* image) const override {
+    known_cells_ = slam::sdp_global_map_image(*slam_, image);
+    return known_cells_;
+  }
+
+  void finish() override { slam_->finish(); }
+
+  std::string status_json() const override {
+    auto u = [](std::uint64_t v) { return std::to_string(v); };
+    std::string js = "\"particles\": " + u(slam_->bottom().particle_count()) + ", \"top_particles\": " +
+                     u(slam_->options().top_particles) + ", \"processed\": " + u(slam_->bottom().stats().processed) +
+                     ", \"committed_poses_dropped\": " + u(permanent_.dropped) + ", \"unrecorded_scans\": " +
+                     u(unrecorded_) + ",\n";
+    // The offline runner's stats.json members; trajectory gaps and known cells as of the
+    // last trajectory() / map_image().
+    js += slam::sdp_state_json(*slam_, arena_bytes_, arena_->used_bytes(), path_gaps_, known_cells_);
+    while (!js.empty() && (js.back() == '\n' || js.back() == ',')) js.pop_back();
+    return js;
+  }
+
+  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+
+ private:
+  std::size_t arena_bytes_ = 0U;
+  std::unique_ptr<unsigned char[]> buffer_;
+  std::unique_ptr<Arena> arena_;
+  std::unique_ptr<SdpSlam> slam_;
+  PathSink permanent_;  // poses of the segments made permanent, global frame
+  std::vector<slam::ScanRecord> scans_;
+  std::uint64_t unrecorded_ = 0U;
+  mutable std::uint64_t path_gaps_ = 0U;
+  mutable std::uint32_t known_cells_ = 0U;
+};
+
 }  // namespace
+
+std::size_t engine_arena_bytes(const DaemonConfig& config) {
+  if (config.mode == SlamMode::kSdp) return SdpSlam::required_arena_bytes(config.slam.filter, config.sdp);
+  return DpSlamFilter::required_arena_bytes(config.slam.filter);
+}
 
 std::unique_ptr<SlamEngine> make_engine(const DaemonConfig& config, std::string* error) {
   if (config.mode == SlamMode::kSdp) {
-    *error = "mode sdp: the SDP-SLAM top level is not part of this build";
-    return nullptr;
+    auto e = std::make_unique<SdpEngine>();
+    if (!e->init(config, error)) return nullptr;
+    return e;
   }
   auto e = std::make_unique<DpSlamEngine>();
   if (!e->init(config, error)) return nullptr;

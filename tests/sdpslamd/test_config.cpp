@@ -5,6 +5,8 @@
 #include <string>
 
 #include "sdpslam/daemon/daemon_config.h"
+#include "sdpslam/daemon/slam_engine.h"
+#include "sdpslam/slam/run_sdp.h"
 #include "shared_data.h"
 
 using sdpslam::daemon::DaemonConfig;
@@ -123,4 +125,78 @@ TEST(SdpslamdConfig, missing_file_is_reported) {
   std::string error;
   CHECK_FALSE(load_daemon_config("/nonexistent/sdpslamd.ini", &c, &error));
   CHECK(error.find("/nonexistent/sdpslamd.ini: cannot open") == 0);
+}
+
+TEST(SdpslamdConfig, shipped_example_keeps_dpslam_as_the_default_mode) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
+  CHECK(c.mode == sdpslam::daemon::SlamMode::kDpSlam);
+}
+
+TEST(SdpslamdConfig, sdp_mode_and_sdp_options_are_accepted) {
+  DaemonConfig c;
+  std::string error;
+  const std::string path = write_ini(
+      "[slam]\nmode = sdp\n[filter]\nparticles = 5\n[sdp]\ntop_particles = 10\nsegmentation = periodic\n"
+      "period_scans = 6\nmin_segment_scans = 3\nmax_segment_scans = 12\ntopology = segslam\n"
+      "map_observation_capacity = 300000\n");
+  CHECK_TRUE_TEXT(load_daemon_config(path, &c, &error), error.c_str());
+  CHECK(c.mode == sdpslam::daemon::SlamMode::kSdp);
+  LONGS_EQUAL(5, c.slam.filter.particle_count);
+  LONGS_EQUAL(10, c.sdp.top_particles);
+  LONGS_EQUAL(6, c.sdp.period_scans);
+  LONGS_EQUAL(3, c.sdp.min_segment_scans);
+  LONGS_EQUAL(12, c.sdp.max_segment_scans);
+  CHECK(c.sdp.topology == sdpslam::TopologyMode::kSegSlam);
+  LONGS_EQUAL(300000, c.sdp.map_observation_capacity);
+}
+
+TEST(SdpslamdConfig, offline_default_ini_loads_as_daemon_config_with_the_offline_sdp_values) {
+  // Every section of tools/slam/default.ini, [sdp] included, is a section of sdpslamd.
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
+  sdpslam::SdpOptions offline;
+  offline.top_particles = 1U;  // differs from the file, so the comparison sees the file was read
+  CHECK_TRUE_TEXT(sdpslam::slam::load_sdp_ini(SDPSLAM_DEFAULT_INI, &offline, &error), error.c_str());
+  LONGS_EQUAL(offline.top_particles, c.sdp.top_particles);
+  LONGS_EQUAL(offline.max_levels, c.sdp.max_levels);
+  LONGS_EQUAL(offline.map_observation_capacity, c.sdp.map_observation_capacity);
+  DOUBLES_EQUAL(offline.period_travel_m, c.sdp.period_travel_m, 0.0);
+  DOUBLES_EQUAL(offline.icp.max_correspondence_m, c.sdp.icp.max_correspondence_m, 0.0);
+}
+
+TEST(SdpslamdConfig, malformed_sdp_value_is_rejected_with_its_line) {
+  expect_rejected("[slam]\nmode = sdp\n[sdp]\ntop_particles = ten\n", 4, "[sdp] top_particles: malformed value 'ten'");
+}
+
+TEST(SdpslamdConfig, out_of_range_sdp_value_is_rejected_with_its_line) {
+  expect_rejected("[sdp]\nmax_levels = 3\nmax_levels = 1\n", 3, "max_levels");
+}
+
+TEST(SdpslamdConfig, unknown_sdp_key_is_rejected_with_its_line) {
+  expect_rejected("[sdp]\ntop_particles = 10\nbottom_particles = 5\n", 3, "unknown key 'bottom_particles' in section [sdp]");
+}
+
+TEST(SdpslamdConfig, sdp_periodic_segmentation_without_a_period_is_rejected_at_the_line_that_removes_it) {
+  expect_rejected("[sdp]\nsegmentation = periodic\nperiod_travel_m = 0\n", 3, "periodic segmentation needs");
+}
+
+TEST(SdpslamdConfig, empty_and_misspelt_modes_are_rejected_with_their_line) {
+  expect_rejected("[can]\ninterface = can0\n[slam]\nmode =\n", 4, "slam.mode: '' is not a SLAM mode (dpslam, sdp)");
+  expect_rejected("[slam]\nseed = 3\nmode = SDP\n", 3, "'SDP' is not a SLAM mode");
+}
+
+TEST(SdpslamdConfig, engine_arena_of_the_shipped_example_is_known_in_both_modes) {
+  // The figures behind the example's default mode (firmware-host/sdpslamd.ini [slam]).
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
+  const std::size_t dpslam_bytes = sdpslam::daemon::engine_arena_bytes(c);
+  c.mode = sdpslam::daemon::SlamMode::kSdp;
+  const std::size_t sdp_bytes = sdpslam::daemon::engine_arena_bytes(c);
+  CHECK(dpslam_bytes > 0U);
+  CHECK(sdp_bytes > 0U);
+  std::printf("\nexample arena: dpslam %zu B, sdp (60T/%uB) %zu B\n", dpslam_bytes, c.slam.filter.particle_count, sdp_bytes);
 }

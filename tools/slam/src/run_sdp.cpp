@@ -18,6 +18,7 @@
 #include "sdpslam/io/log_reader.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
+#include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::slam {
 namespace {
@@ -84,13 +85,6 @@ class Rows final : public TopLevelListener {
   std::vector<Row> rows;
 };
 
-struct ScanLog {
-  std::int64_t stamp_us;
-  Pose2 odom;
-  Pose2 online;
-  bool processed;
-};
-
 double thread_cpu_ms() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -108,75 +102,6 @@ std::string fmt(const char* f, double v) {
   char b[64];
   std::snprintf(b, sizeof b, f, v);
   return b;
-}
-
-// The best combination's global map: every view's known cells moved into the global frame
-// (nearest cell), hits and misses summed per cell.
-std::uint32_t global_map_image(const SdpSlam& slam, io::OccupancyImage* image) {
-  const DpSlamFilter& f = slam.bottom();
-  const DpMap& map = f.map();
-  const double res = map.resolution_m();
-  const double ox = map.options().origin_x_m;
-  const double oy = map.options().origin_y_m;
-  // Bounds in the global frame.
-  double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
-  slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
-    if (r.width == 0U || r.height == 0U) return;
-    const double xs[2] = {ox + r.ix0 * res, ox + (r.ix0 + static_cast<double>(r.width)) * res};
-    const double ys[2] = {oy + r.iy0 * res, oy + (r.iy0 + static_cast<double>(r.height)) * res};
-    for (double x : xs) {
-      for (double y : ys) {
-        double gx = 0.0, gy = 0.0;
-        frame.transform_point(x, y, gx, gy);
-        gx0 = std::min(gx0, gx);
-        gy0 = std::min(gy0, gy);
-        gx1 = std::max(gx1, gx);
-        gy1 = std::max(gy1, gy);
-      }
-    }
-  });
-  if (!(gx1 > gx0) || !(gy1 > gy0)) return 0U;
-  // Aligned to the DP map's grid so that an identity frame maps cells exactly.
-  const double ax0 = ox + std::floor((gx0 - ox) / res) * res;
-  const double ay0 = oy + std::floor((gy0 - oy) / res) * res;
-  const auto w = static_cast<std::uint32_t>(std::ceil((gx1 - ax0) / res)) + 1U;
-  const auto h = static_cast<std::uint32_t>(std::ceil((gy1 - ay0) / res)) + 1U;
-  std::vector<CellObservation> sum(static_cast<std::size_t>(w) * h);
-  std::vector<std::uint8_t> any(sum.size(), 0U);
-  std::uint32_t known_cells = 0U;
-  slam.for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
-    if (r.width == 0U || r.height == 0U) return;
-    std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
-    std::vector<std::uint8_t> k(v.size(), 0U);
-    map.fill_rect(node, r, v.data(), k.data());
-    for (std::uint32_t y = 0; y < r.height; ++y) {
-      for (std::uint32_t x = 0; x < r.width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
-        if (k[i] == 0U) continue;
-        double cx = 0.0, cy = 0.0, gx = 0.0, gy = 0.0;
-        map.cell_center(r.ix0 + static_cast<std::int32_t>(x), r.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
-        frame.transform_point(cx, cy, gx, gy);
-        const double fx = std::floor((gx - ax0) / res);
-        const double fy = std::floor((gy - ay0) / res);
-        if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) continue;
-        const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
-        sum[g] = accumulate(sum[g], v[i].hits, v[i].misses);
-        any[g] = 1U;
-      }
-    }
-  });
-  image->width = w;
-  image->height = h;
-  image->resolution_m = res;
-  image->origin_x_m = ax0;
-  image->origin_y_m = ay0;
-  image->occupancy.assign(sum.size(), -1.0F);
-  for (std::size_t i = 0; i < sum.size(); ++i) {
-    if (any[i] == 0U) continue;
-    image->occupancy[i] = static_cast<float>(f.occupancy(sum[i]));
-    ++known_cells;
-  }
-  return known_cells;
 }
 
 // Line plot of the per-round ICP error (mean, with a ±std band), rasterised on an
@@ -348,7 +273,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   slam->set_permanent_sink(&permanent);
   slam->set_listener(&rows);
 
-  std::vector<ScanLog> scans;
+  std::vector<ScanRecord> scans;
   std::vector<double> scan_ms;
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
   double cpu_max_by_kind[4] = {0.0, 0.0, 0.0, 0.0};
@@ -388,7 +313,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     const int kind = r.segmented != SegmentEnd::kNone ? 0 : (r.evaluations > 0U ? 1 : (r.work_cells > 0U ? 2 : 3));
     cpu_max_by_kind[kind] = std::max(cpu_max_by_kind[kind], cpu);
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
-    scans.push_back(ScanLog{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
+    scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
     if (options.progress && scans.size() % 200U == 0U) {
       std::fprintf(stderr, "\rscans %zu processed %llu segments %llu", scans.size(),
                    static_cast<unsigned long long>(slam->bottom().stats().processed),
@@ -403,44 +328,13 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   slam->finish();
 
   // The best combination's path: permanent segments, then the live chain.
-  std::vector<io::StampedPose> path = permanent.poses;
-  slam->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
-  std::vector<io::StampedPose> trajectory;
-  trajectory.reserve(scans.size());
-  std::size_t pi = 0U;
-  bool anchored = false;
-  Pose2 anchor_pose;
-  Pose2 anchor_odom;
   std::uint64_t path_gaps = 0U;
-  for (const ScanLog& s : scans) {
-    Pose2 pose;
-    bool from_path = false;
-    if (s.processed) {
-      while (pi < path.size() && path[pi].stamp_us < s.stamp_us) ++pi;
-      if (pi < path.size() && path[pi].stamp_us == s.stamp_us) {
-        pose = path[pi].pose;
-        ++pi;
-        from_path = true;
-      } else {
-        ++path_gaps;
-      }
-    }
-    if (!from_path) pose = anchored ? anchor_pose.compose(between(anchor_odom, s.odom)) : s.online;
-    if (from_path || !anchored) {
-      anchor_pose = pose;
-      anchor_odom = s.odom;
-      anchored = true;
-    }
-    trajectory.push_back({s.stamp_us, pose});
-  }
+  const std::vector<io::StampedPose> trajectory =
+      assemble_trajectory(scans, sdp_best_path(*slam, permanent.poses), &path_gaps);
 
   io::OccupancyImage image;
-  const std::uint32_t known_cells = global_map_image(*slam, &image);
-  if (!io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error)) return SdpRunStatus::kIoError;
-  if (image.width > 0U) {
-    if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return SdpRunStatus::kIoError;
-    if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return SdpRunStatus::kIoError;
-  }
+  const std::uint32_t known_cells = sdp_global_map_image(*slam, &image);
+  if (!write_trajectory_and_map(out_dir, trajectory, image, error)) return SdpRunStatus::kIoError;
   std::string csv = "stamp_s,mean_m,std_m,samples\n";
   for (const Row& r : rows.rows) {
     char line[128];
@@ -454,12 +348,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   }
 
   // stats.json
-  const DpSlamFilter& bottom = slam->bottom();
-  const AncestryTree& tree = bottom.tree();
-  const DpMap& map = bottom.map();
-  const DpSlamStats& bs = bottom.stats();
+  const DpSlamStats& bs = slam->bottom().stats();
   const SdpStats& st = slam->stats();
-  const SegmentGraph& g = slam->graph();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -474,34 +364,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(bs.processed) + ",\n";
   js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
-  js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
-  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
-        u(st.submaps_released) + ",\n";
-  js += "  \"icp_error\": {\"mean_m\": " + fmt("%.6f", st.error_mean_m()) + ", \"std_m\": " +
-        fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
-        ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
-        ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
-  js += "  \"pools\": {\n";
-  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
-        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(bs.node_fallback_count) + "},\n";
-  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
-        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
-  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
-        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
-  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
-        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
-  js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +
-        ", \"refused\": " + u(st.pgs_refused) + "},\n";
-  js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +
-        u(slam->permanent_submap_count()) + ", \"forgotten\": " + u(st.permanent_forgotten) + "},\n";
-  js += "    \"pose_ring\": {\"capacity\": " + u(slam->pose_ring_capacity()) + ", \"peak\": " + u(st.pose_ring_peak) +
-        ", \"dropped\": " + u(st.pose_ring_dropped) + "},\n";
-  js += "    \"map_updates_dropped\": " + u(bs.map_updates_dropped) + ",\n";
-  js += "    \"global_map_updates_dropped\": " + u(st.map_transfer_dropped) + ",\n";
-  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
-  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
-  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"arena_used_bytes\": " + u(arena.used_bytes()) +
-        ", \"global_map_known_cells\": " + u(known_cells) + "},\n";
+  js += sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells);
   js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
         fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
         ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"segmentation_scan_ms_max\": " +

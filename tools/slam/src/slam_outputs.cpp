@@ -1,5 +1,9 @@
 #include "sdpslam/slam/slam_outputs.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
 namespace sdpslam::slam {
 
 std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& scans,
@@ -65,6 +69,129 @@ bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::
     if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return false;
   }
   return true;
+}
+
+// ---- SDP-SLAM ------------------------------------------------------------------------
+
+std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const std::vector<io::StampedPose>& permanent) {
+  std::vector<io::StampedPose> path = permanent;
+  slam.for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
+  return path;
+}
+
+std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image) {
+  *image = io::OccupancyImage{};
+  const DpSlamFilter& f = slam.bottom();
+  const DpMap& map = f.map();
+  const double res = map.resolution_m();
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  // Bounds in the global frame.
+  double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
+  slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    const double xs[2] = {ox + r.ix0 * res, ox + (r.ix0 + static_cast<double>(r.width)) * res};
+    const double ys[2] = {oy + r.iy0 * res, oy + (r.iy0 + static_cast<double>(r.height)) * res};
+    for (double x : xs) {
+      for (double y : ys) {
+        double gx = 0.0, gy = 0.0;
+        frame.transform_point(x, y, gx, gy);
+        gx0 = std::min(gx0, gx);
+        gy0 = std::min(gy0, gy);
+        gx1 = std::max(gx1, gx);
+        gy1 = std::max(gy1, gy);
+      }
+    }
+  });
+  if (!(gx1 > gx0) || !(gy1 > gy0)) return 0U;
+  // Aligned to the DP map's grid so that an identity frame maps cells exactly.
+  const double ax0 = ox + std::floor((gx0 - ox) / res) * res;
+  const double ay0 = oy + std::floor((gy0 - oy) / res) * res;
+  const auto w = static_cast<std::uint32_t>(std::ceil((gx1 - ax0) / res)) + 1U;
+  const auto h = static_cast<std::uint32_t>(std::ceil((gy1 - ay0) / res)) + 1U;
+  std::vector<CellObservation> sum(static_cast<std::size_t>(w) * h);
+  std::vector<std::uint8_t> any(sum.size(), 0U);
+  std::uint32_t known_cells = 0U;
+  slam.for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
+    std::vector<std::uint8_t> k(v.size(), 0U);
+    map.fill_rect(node, r, v.data(), k.data());
+    for (std::uint32_t y = 0; y < r.height; ++y) {
+      for (std::uint32_t x = 0; x < r.width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
+        if (k[i] == 0U) continue;
+        double cx = 0.0, cy = 0.0, gx = 0.0, gy = 0.0;
+        map.cell_center(r.ix0 + static_cast<std::int32_t>(x), r.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
+        frame.transform_point(cx, cy, gx, gy);
+        const double fx = std::floor((gx - ax0) / res);
+        const double fy = std::floor((gy - ay0) / res);
+        if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) continue;
+        const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
+        sum[g] = accumulate(sum[g], v[i].hits, v[i].misses);
+        any[g] = 1U;
+      }
+    }
+  });
+  image->width = w;
+  image->height = h;
+  image->resolution_m = res;
+  image->origin_x_m = ax0;
+  image->origin_y_m = ay0;
+  image->occupancy.assign(sum.size(), -1.0F);
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    if (any[i] == 0U) continue;
+    image->occupancy[i] = static_cast<float>(f.occupancy(sum[i]));
+    ++known_cells;
+  }
+  return known_cells;
+}
+
+std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
+                           std::uint64_t path_gaps, std::uint32_t known_cells) {
+  const DpSlamFilter& bottom = slam.bottom();
+  const AncestryTree& tree = bottom.tree();
+  const DpMap& map = bottom.map();
+  const DpSlamStats& bs = bottom.stats();
+  const SdpStats& st = slam.stats();
+  const SegmentGraph& g = slam.graph();
+  const SdpOptions& so = slam.options();
+  auto u = [](std::uint64_t v) { return std::to_string(v); };
+  auto fmt = [](const char* f, double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, f, v);
+    return std::string(b);
+  };
+  std::string js;
+  js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
+  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
+        u(st.submaps_released) + ",\n";
+  js += "  \"icp_error\": {\"mean_m\": " + fmt("%.6f", st.error_mean_m()) + ", \"std_m\": " +
+        fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
+        ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
+        ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
+  js += "  \"pools\": {\n";
+  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
+        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(bs.node_fallback_count) + "},\n";
+  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
+        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
+  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
+        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
+  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
+        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +
+        ", \"refused\": " + u(st.pgs_refused) + "},\n";
+  js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +
+        u(slam.permanent_submap_count()) + ", \"forgotten\": " + u(st.permanent_forgotten) + "},\n";
+  js += "    \"pose_ring\": {\"capacity\": " + u(slam.pose_ring_capacity()) + ", \"peak\": " + u(st.pose_ring_peak) +
+        ", \"dropped\": " + u(st.pose_ring_dropped) + "},\n";
+  js += "    \"map_updates_dropped\": " + u(bs.map_updates_dropped) + ",\n";
+  js += "    \"global_map_updates_dropped\": " + u(st.map_transfer_dropped) + ",\n";
+  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
+  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
+  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"arena_used_bytes\": " + u(arena_used_bytes) +
+        ", \"global_map_known_cells\": " + u(known_cells) + "},\n";
+  return js;
 }
 
 }  // namespace sdpslam::slam

@@ -99,7 +99,9 @@ class Daemon {
   // Steps until *stop != 0, then finishes (see header). Returns true iff the final
   // outputs were written.
   bool run(const volatile std::sig_atomic_t* stop);
-  // Places every queued scan that can be placed now (no waiting), then writes the outputs.
+  // Places every queued scan that can be placed now (no waiting), ends the engine's input
+  // (SlamEngine::finish: the last outputs are the offline runner's), then writes the
+  // outputs. Call once, at the end.
   bool finish();
   // Writes trajectory, map (if enabled) and status now. True iff all writes succeeded.
   bool write_outputs();

@@ -7,8 +7,12 @@
 //   [robot]   differential-drive geometry (drivers::DiffDriveParams)
 //   [sync]    odometry-to-scan alignment: wait bound, largest gap interpolated, queue
 //   [slam]    mode (dpslam | sdp) and seed; the filter's own sections [filter] [motion]
-//             [observation] [map] [capacity] [log] are the offline runner's
+//             [observation] [proposal] [map] [capacity] [log] are the offline runner's
 //             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
+//   [sdp]     SDP-SLAM's segmentation and top level (mode = sdp), the offline runner's
+//             [sdp] keys, parsed by the same code (slam::apply_sdp_key); read in either
+//             mode, used in sdp mode only. The bottom level of sdp mode is [filter] etc.,
+//             with [filter] particles as B (the offline runner takes B from --particles)
 //   [output]  directory, write period, trajectory capacity, map, input recording
 //   [daemon]  event-log rate limit, loop slice
 // Unknown sections and keys, malformed and out-of-range values are rejected as
@@ -17,6 +21,7 @@
 #include <string>
 
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/sdp_options.h"
 #include "sdpslam/drivers/can_wheel_encoders.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/drivers/sick_lms2xx_laser.h"
@@ -53,6 +58,8 @@ struct DaemonConfig {
   SlamMode mode = SlamMode::kDpSlam;
   std::uint64_t seed = 1U;
   slam::SlamConfig slam;
+  // [sdp]
+  SdpOptions sdp;
   // [output]
   std::string output_directory = "/var/lib/sdpslamd";
   std::int64_t output_period_us = 5000000;
@@ -69,8 +76,9 @@ struct DaemonConfig {
 // Applies the keys of `path` on top of *config. False iff the file cannot be read, a line
 // is malformed, a section or key is unknown, or a value is malformed or out of range;
 // `error` is then "file:line: reason" (the first problem; *config is then unspecified).
-// Checks that involve several keys (SICK variant, drive geometry, filter options) run
-// once the file is read and name the file and the section.
+// Checks that involve several keys (SICK variant, drive geometry, filter options, and in
+// sdp mode the [sdp] options and the bottom options SDP-SLAM derives from [filter] etc.)
+// run once the file is read and name the file and the section.
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error);
 
 }  // namespace sdpslam::daemon

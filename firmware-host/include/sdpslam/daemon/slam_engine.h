@@ -1,12 +1,17 @@
 #pragma once
 // The SLAM algorithm behind sdpslamd, as a small seam so that the modes of [slam] mode
 // plug in alike: `dpslam` (the bottom-level DP-SLAM filter, core/dpslam_filter.h) and
-// `sdp` (the SDP-SLAM top level, once the core provides it).
+// `sdp` (Segmented DP-SLAM, core/sdp_slam.h, with the [sdp] options).
+//
+// Both write what the offline runner writes from the same state, through the same code
+// (tools/slam slam_outputs.h): dpslam the best particle's path and map, sdp the best
+// combination's path (permanent segments + live chain) and global map.
 //
 // An engine owns all of its memory, sized once at create time from the options; process()
-// does not allocate except to append to the scan record, whose capacity is reserved at
-// create time too (max_trajectory_scans; beyond it scans are still processed but no
-// longer recorded, counted in unrecorded_scans()).
+// does not allocate except to append to the scan record and the committed-pose record,
+// whose capacities are reserved at create time too (max_trajectory_scans; beyond it scans
+// are still processed but no longer recorded, counted in unrecorded_scans() and
+// "committed_poses_dropped"). trajectory() and map_image() allocate: output steps only.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -36,7 +41,18 @@ class SlamEngine {
   // Engine counters as JSON members (`"key": value` pairs, comma separated, no braces).
   virtual std::string status_json() const = 0;
   virtual std::uint64_t unrecorded_scans() const = 0;
+  // The input has ended: complete deferred work so that the final outputs are those of
+  // the offline runner at the end of its log (sdp: SdpSlam::finish(), the pending
+  // skeletons and global-map transfer; not bounded by the per-scan budget). Call once,
+  // before the last trajectory()/map_image(); the periodic outputs never call it, so
+  // they do not change what later scans do.
+  virtual void finish() {}
 };
+
+// Bytes of the one arena the configured engine carves its state from at create time
+// (DpSlamFilter / SdpSlam::required_arena_bytes); 0 iff the options are invalid. The
+// scan record (max_trajectory_scans × ~64 B) comes on top.
+std::size_t engine_arena_bytes(const DaemonConfig& config);
 
 // Builds the engine the configuration asks for. Null (with *error) iff the mode is not
 // available in this build or its memory cannot be set up.

@@ -9,11 +9,17 @@
 //  - best_map_image: the best particle's occupancy grid over every tile ever written.
 //  - write_trajectory_and_map: trajectory.txt, map.pgm/.yaml and map.png (with the
 //    trajectory drawn) in out_dir, each atomically (tools/io).
+// and of an SDP-SLAM run (core/sdp_slam.h; `sdpslam run --mode sdp`, sdpslamd
+// [slam] mode = sdp), so both write the best combination's path and global map:
+//  - sdp_best_path: the best combination's poses, the input of assemble_trajectory;
+//  - sdp_global_map_image: the best combination's global map;
+//  - sdp_state_json: the deterministic counters, pools and memory of stats.json.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 
@@ -43,5 +49,26 @@ std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* ima
 // written and the previous versions of the others stay complete.
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                               const io::OccupancyImage& image, std::string* error);
+
+// ---- SDP-SLAM ------------------------------------------------------------------------
+
+// The best combination's path, oldest first: `permanent` (what SdpSlam's permanent pose
+// sink received: the segments made permanent, global frame) followed by the live levels'
+// chosen submaps and the current segment's best particle (SdpSlam::for_each_best_pose).
+std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const std::vector<io::StampedPose>& permanent);
+
+// The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map node plus
+// each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
+// misses summed per cell; aligned to the DP map's grid. Returns the known cells; `image`
+// stays empty (width 0) when nothing was ever written. Allocates (the image, one view at
+// a time): an output step, not a per-scan one.
+std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image);
+
+// The deterministic part of an SDP-SLAM stats.json: "segments" through "memory", one
+// member per line, each line indented by two spaces and ending with ",\n".
+// `arena_bytes` / `arena_used_bytes`: the arena given to init() and its used bytes;
+// `path_gaps`: from assemble_trajectory; `known_cells`: from sdp_global_map_image.
+std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
+                           std::uint64_t path_gaps, std::uint32_t known_cells);
 
 }  // namespace sdpslam::slam
