@@ -1,6 +1,10 @@
 #!/bin/sh
 # End-to-end run of sdpslamd on the host, checked exactly against the offline runner.
-#   e2e_host.sh SDPSLAMD REPLAY SDPSLAM MAKE_CANDUMP LOG WORK LINES SPEED [FIDELITY]
+#   e2e_host.sh SDPSLAMD REPLAY SDPSLAM MAKE_CANDUMP LOG WORK LINES SPEED [FIDELITY [MODE]]
+# MODE: dpslam (default: the bottom-level filter, 5 particles) or sdp (SDP-SLAM, 10 top /
+# 5 bottom particles, a segment every 6 processed scans, 3 live levels: in 150 lines
+# several segments end and older levels become permanent, so the trajectory holds
+# permanent, live and current poses).
 # The first LINES lines of a tinySLAM log (real wheel ticks + URG scans): the scans are
 # served by a SCIP 2.0 emulator on a pty, the ticks as CANopen SYNC + TPDO1 frames
 # (nodes 1, 2) through sdpslamd's --can-candump replay started on the laser's instant.
@@ -8,7 +12,7 @@
 # odometry pose and stamp, as SLAM got them).
 #
 # Checks (zero tolerance): sdpslamd dropped no scan, its recording holds one line per
-# placed scan, and `sdpslam run input.clf --mode dpslam` with the same options and seed
+# placed scan, and `sdpslam run input.clf --mode MODE` with the same options and seed
 # writes a trajectory.txt and map.pgm byte-identical to sdpslamd's (same stamps: the
 # recording carries sdpslamd's own). This is what "sdpslamd runs the same SLAM as the
 # offline runner" can promise exactly.
@@ -21,6 +25,22 @@
 # Exit 77 when the log is absent.
 set -u
 daemon=$1 replay=$2 sdpslam=$3 make_candump=$4 log=$5 work=$6 lines=${7:-150} speed=${8:-1} fidelity=${9:-}
+mode=${10:-dpslam}
+case $mode in
+  dpslam) sdp_section='' ;;
+  # Keys in this order: each [sdp] key is validated as it is read, and periodic
+  # segmentation needs some period at every step.
+  sdp) sdp_section='[sdp]
+top_particles = 10
+period_scans = 6
+period_travel_m = 0
+min_segment_scans = 3
+max_segment_scans = 30
+max_levels = 3
+map_tile_capacity = 2000
+map_observation_capacity = 400000' ;;
+  *) echo "FAIL: unknown mode $mode"; exit 1 ;;
+esac
 [ -f "$log" ] || { echo "SKIP: $log is absent (shared data sets live beside the checkout)"; exit 77; }
 rm -rf "$work" && mkdir -p "$work/daemon" "$work/offline" "$work/recorded"
 head -n "$lines" "$log" >"$work/log.dat"
@@ -43,6 +63,7 @@ x_m = 0.145
 odometry_wait_ms = 400
 max_interpolation_gap_ms = 500
 [slam]
+mode = $mode
 seed = 1
 [filter]
 particles = 5
@@ -51,6 +72,7 @@ width_m = 40
 height_m = 40
 observations_base = 300000
 observations_per_particle = 20000
+$sdp_section
 [output]
 directory = $work/daemon
 period_s = 2
@@ -77,17 +99,26 @@ placed=$(sed -n 's/.*"placed": \([0-9]*\).*/\1/p' "$work/daemon/status.json")
 recorded=$(grep -c '^ROBOTLASER1 ' "$work/daemon/input.clf")
 [ "$placed" = "$recorded" ] && [ "$placed" -gt 0 ] || { echo "FAIL: $placed scans placed but $recorded recorded"; exit 1; }
 # Exact: the offline runner on sdpslamd's recorded input.
-"$sdpslam" run "$work/daemon/input.clf" --mode dpslam --config "$work/offline.ini" --seed 1 --out "$work/recorded" \
+# The offline runner takes sdp's bottom particle count from --particles, not [filter].
+"$sdpslam" run "$work/daemon/input.clf" --mode "$mode" --particles 5 --config "$work/offline.ini" --seed 1 --out "$work/recorded" \
   2>"$work/recorded.log" || { cat "$work/recorded.log"; echo "FAIL: sdpslam run on the recording failed"; exit 1; }
 grep -q '"log_errors": 0' "$work/recorded/stats.json" || { echo "FAIL: the recording has unreadable lines"; exit 1; }
 for f in trajectory.txt map.pgm; do
   cmp "$work/daemon/$f" "$work/recorded/$f" || { echo "FAIL: $f of sdpslamd and of sdpslam run on its recording differ"; exit 1; }
 done
-echo "exact: sdpslam run on input.clf reproduces sdpslamd's trajectory.txt ($(grep -vc '^#' "$work/daemon/trajectory.txt") poses) and map.pgm byte for byte"
+if [ "$mode" = sdp ]; then
+  segs=$(sed -n 's/^  "segments": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
+  grep -q "\"segments\": $segs," "$work/recorded/stats.json" || { echo "FAIL: segment counts differ"; exit 1; }
+  [ "${segs:-0}" -ge 2 ] || { echo "FAIL: only ${segs:-0} segments: the test no longer exercises the top level"; exit 1; }
+  perm=$(sed -n 's/^  "levels_made_permanent": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
+  [ "${perm:-0}" -ge 1 ] || { echo "FAIL: no level became permanent: the test no longer exercises that path"; exit 1; }
+  echo "segments: $segs, levels made permanent: $perm (sdpslamd and sdpslam run alike)"
+fi
+echo "exact ($mode): sdpslam run on input.clf reproduces sdpslamd's trajectory.txt ($(grep -vc '^#' "$work/daemon/trajectory.txt") poses) and map.pgm byte for byte"
 # Figures: the replay against the original log.
 set -- $(sed -n 's/^timeline: play_start_us \([0-9]*\) log_start_us \([0-9]*\) speed \(.*\)/\1 \2 \3/p' "$work/replay.log")
 [ -n "$fidelity" ] && { "$fidelity" "$work/log.dat" "$work/daemon/input.clf" "$1" "$2" "$3" || echo "note: fidelity comparison incomplete"; }
-"$sdpslam" run "$work/log.dat" --mode dpslam --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
+"$sdpslam" run "$work/log.dat" --mode "$mode" --particles 5 --config "$work/offline.ini" --seed 1 --out "$work/offline" 2>/dev/null || exit 1
 printf 'against the original log (figure): '
 sh "$(dirname "$0")/compare_trajectories.sh" "$work/daemon/trajectory.txt" "$work/offline/trajectory.txt" "$1" "$2" "$3" 1e9 10 1e9 || true
 exit 0
