@@ -101,8 +101,9 @@ int main(int argc, char** argv) {
   }
   if (!out_dir.empty()) config.output_directory = out_dir;
   if (check_only) {
-    std::printf("%s: ok (mode %s, %u particles, laser %s on %s, encoders %s on %s, outputs in %s)\n",
+    std::printf("%s: ok (mode %s, %u particles, %.1f MB SLAM arena, laser %s on %s, encoders %s on %s, outputs in %s)\n",
                 config_path.c_str(), daemon::to_string(config.mode), config.slam.filter.particle_count,
+                static_cast<double>(daemon::engine_arena_bytes(config)) * 1e-6,
                 daemon::to_string(config.laser_protocol), config.laser_device.c_str(),
                 drivers::to_string(config.encoders.protocol), config.can_interface.c_str(),
                 config.output_directory.c_str());

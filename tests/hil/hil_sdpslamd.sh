@@ -42,6 +42,7 @@ odometry_wait_ms = 400
 max_interpolation_gap_ms = 1500
 scan_queue = 16
 [slam]
+mode = dpslam
 seed = 1
 [filter]
 particles = 5

@@ -127,11 +127,14 @@ TEST(SdpslamdConfig, missing_file_is_reported) {
   CHECK(error.find("/nonexistent/sdpslamd.ini: cannot open") == 0);
 }
 
-TEST(SdpslamdConfig, shipped_example_keeps_dpslam_as_the_default_mode) {
+TEST(SdpslamdConfig, shipped_example_and_the_built_in_default_select_sdp) {
   DaemonConfig c;
+  CHECK(c.mode == sdpslam::daemon::SlamMode::kSdp);
+  c.mode = sdpslam::daemon::SlamMode::kDpSlam;
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
-  CHECK(c.mode == sdpslam::daemon::SlamMode::kDpSlam);
+  CHECK(c.mode == sdpslam::daemon::SlamMode::kSdp);
+  LONGS_EQUAL(60, c.sdp.top_particles);
 }
 
 TEST(SdpslamdConfig, sdp_mode_and_sdp_options_are_accepted) {
@@ -188,15 +191,16 @@ TEST(SdpslamdConfig, empty_and_misspelt_modes_are_rejected_with_their_line) {
   expect_rejected("[slam]\nseed = 3\nmode = SDP\n", 3, "'SDP' is not a SLAM mode");
 }
 
-TEST(SdpslamdConfig, engine_arena_of_the_shipped_example_is_known_in_both_modes) {
-  // The figures behind the example's default mode (firmware-host/sdpslamd.ini [slam]).
+TEST(SdpslamdConfig, sdp_mode_of_the_shipped_example_needs_less_memory_than_dpslam) {
+  // Why the example (and the built-in default) is sdp: it fits the memory dpslam takes
+  // with the same file (firmware-host/sdpslamd.ini [slam] gives the figures).
   DaemonConfig c;
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
-  const std::size_t dpslam_bytes = sdpslam::daemon::engine_arena_bytes(c);
-  c.mode = sdpslam::daemon::SlamMode::kSdp;
   const std::size_t sdp_bytes = sdpslam::daemon::engine_arena_bytes(c);
-  CHECK(dpslam_bytes > 0U);
+  c.mode = sdpslam::daemon::SlamMode::kDpSlam;
+  const std::size_t dpslam_bytes = sdpslam::daemon::engine_arena_bytes(c);
   CHECK(sdp_bytes > 0U);
+  CHECK(sdp_bytes < dpslam_bytes);
   std::printf("\nexample arena: dpslam %zu B, sdp (60T/%uB) %zu B\n", dpslam_bytes, c.slam.filter.particle_count, sdp_bytes);
 }

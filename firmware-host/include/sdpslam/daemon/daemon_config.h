@@ -55,7 +55,9 @@ struct DaemonConfig {
   std::int64_t max_interpolation_gap_us = 250000;
   std::uint32_t scan_queue = 4U;             // scans waiting for odometry, 1 .. kMaxScanQueue
   // [slam]
-  SlamMode mode = SlamMode::kDpSlam;
+  // SDP-SLAM, the project's algorithm (the offline runner's default too): with the example's
+  // options its arena is smaller than dpslam's (sdpslamd.ini [slam] gives the figures).
+  SlamMode mode = SlamMode::kSdp;
   std::uint64_t seed = 1U;
   slam::SlamConfig slam;
   // [sdp]
