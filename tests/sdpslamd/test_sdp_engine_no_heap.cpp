@@ -1,0 +1,77 @@
+// sdpslamd's SDP engine: once created, process() never touches the heap (the core's
+// guarantee plus the engine's own records, reserved at create time), across segments.
+#include <CppUTest/TestHarness.h>
+
+#include <cmath>
+#include <string>
+
+#include "alloc_counter.h"
+#include "sdpslam/daemon/slam_engine.h"
+
+using sdpslam::daemon::DaemonConfig;
+
+namespace {
+
+// A 10 m x 6 m box seen from (x, y) looking along +x: 181 beams over 180 degrees.
+void box_scan(double x, double y, std::int64_t stamp_us, sdpslam::RangeScan* s) {
+  s->stamp_us = stamp_us;
+  s->beam_count = 181U;
+  s->geometry.angle_min_rad = static_cast<float>(-M_PI / 2.0);
+  s->geometry.angle_increment_rad = static_cast<float>(M_PI / 180.0);
+  s->geometry.range_min_m = 0.05F;
+  s->geometry.range_max_m = 30.0F;
+  for (std::uint32_t i = 0; i < s->beam_count; ++i) {
+    const double a = static_cast<double>(s->beam_angle_rad(i));
+    const double c = std::cos(a), n = std::sin(a);
+    double t = 1e9;
+    if (c > 1e-9) t = std::fmin(t, (10.0 - x) / c);
+    if (c < -1e-9) t = std::fmin(t, (0.0 - x) / c);
+    if (n > 1e-9) t = std::fmin(t, (6.0 - y) / n);
+    if (n < -1e-9) t = std::fmin(t, (0.0 - y) / n);
+    s->ranges_m[i] = static_cast<float>(t);
+  }
+}
+
+}  // namespace
+
+TEST_GROUP(SdpEngineNoHeap){};
+
+TEST(SdpEngineNoHeap, process_does_not_allocate_across_segmentations) {
+  DaemonConfig c;
+  c.mode = sdpslam::daemon::SlamMode::kSdp;
+  c.slam.filter.particle_count = 5U;
+  c.slam.filter.update_min_travel_m = 0.1;
+  c.slam.filter.map_width_m = 30.0;
+  c.slam.filter.map_height_m = 30.0;
+  c.sdp.top_particles = 8U;
+  c.sdp.period_scans = 5U;
+  c.sdp.period_travel_m = 0.0;
+  c.sdp.min_segment_scans = 3U;
+  c.sdp.max_levels = 3U;
+  c.sdp.map_tile_capacity = 2000U;
+  c.sdp.map_observation_capacity = 300000U;
+  c.max_trajectory_scans = 200U;
+  std::string error;
+  auto engine = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(engine != nullptr, error.c_str());
+  static sdpslam::RangeScan scan;
+  std::size_t allocations = 0U;
+  std::uint32_t processed = 0U;
+  for (int k = 0; k < 120; ++k) {
+    const double x = 2.0 + 0.05 * k;
+    box_scan(x, 3.0, 1000000 + 100000LL * k, &scan);
+    const sdpslam::OdometrySample odom{scan.stamp_us, sdpslam::Pose2{x - 2.0, 0.0, 0.0}};
+    sdpslam::test::AllocationScope scope;
+    const sdpslam::daemon::EngineStep step = engine->process(odom, scan);
+    allocations += scope.allocations();
+    if (step.processed) ++processed;
+  }
+  LONGS_EQUAL(0, allocations);
+  CHECK(processed >= 30U);
+  // Several segments ended (so the no-heap claim covers anchorage and the top level).
+  const std::string status = engine->status_json();
+  const std::size_t at = status.find("\"levels_made_permanent\": ");
+  CHECK(at != std::string::npos);
+  CHECK(std::stoul(status.substr(at + 25)) >= 1U);
+  LONGS_EQUAL(120, static_cast<long>(engine->trajectory().size()));
+}
