@@ -45,7 +45,7 @@ TEST(SdpslamdConfig, shipped_example_config_loads_with_documented_defaults) {
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
   STRCMP_EQUAL("can0", c.can_interface.c_str());
-  LONGS_EQUAL(30, c.slam.filter.particle_count);
+  LONGS_EQUAL(10, c.slam.filter.particle_count);
   LONGS_EQUAL(10000, c.encoders.canopen.sync_period_us);
   DOUBLES_EQUAL(0.33, c.drive.wheel_separation_m, 1e-12);
   LONGS_EQUAL(5000000, c.output_period_us);
