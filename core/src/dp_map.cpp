@@ -63,7 +63,8 @@ std::size_t DpMap::required_arena_bytes(const Options& options, std::uint32_t no
   GridDims d;
   if (!grid_dims(options, &d)) return 0U;
   return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + kOwnerTables * node_capacity) +
-         3U * alignof(std::uint32_t) + sizeof(std::uint32_t) * index_slots_for(options.observation_capacity) +
+         3U * alignof(std::uint32_t) +
+         (options.owner_cell_index ? sizeof(std::uint32_t) * index_slots_for(options.observation_capacity) : 0U) +
          pool_bytes<Tile>(options.tile_capacity) +
          pool_bytes<Observation>(options.observation_capacity);
 }
@@ -76,14 +77,19 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   tile_table_ = arena.allocate_array<std::uint32_t>(table_entries);
   const std::size_t cap = tree.capacity();
   std::uint32_t* owners = arena.allocate_array<std::uint32_t>(kOwnerTables * cap);
-  const std::size_t slots = index_slots_for(options.observation_capacity);
-  index_ = arena.allocate_array<std::uint32_t>(slots);
-  if (tile_table_ == nullptr || owners == nullptr || index_ == nullptr) return false;
-  for (std::size_t i = 0; i < slots; ++i) index_[i] = kNone;
-  index_mask_ = static_cast<std::uint32_t>(slots - 1U);
-  std::uint32_t bits = 0U;
-  while ((std::size_t{1} << bits) < slots) ++bits;
-  index_shift_ = 64U - bits;
+  if (tile_table_ == nullptr || owners == nullptr) return false;
+  index_ = nullptr;
+  index_mask_ = 0U;
+  if (options.owner_cell_index) {
+    const std::size_t slots = index_slots_for(options.observation_capacity);
+    index_ = arena.allocate_array<std::uint32_t>(slots);
+    if (index_ == nullptr) return false;
+    for (std::size_t i = 0; i < slots; ++i) index_[i] = kNone;
+    index_mask_ = static_cast<std::uint32_t>(slots - 1U);
+    std::uint32_t bits = 0U;
+    while ((std::size_t{1} << bits) < slots) ++bits;
+    index_shift_ = 64U - bits;
+  }
   owner_node_ = owners;
   node_owner_ = owners + cap;
   owner_head_ = owners + 2U * cap;
@@ -145,6 +151,7 @@ std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_
     if (node == particle || query.has_ancestor_or_self(node)) return e;
     e = o.next_in_cell;
     if (e == kNone) return kNone;  // the list is exhausted: no ancestor-or-self here
+    if (index_ == nullptr) continue;  // no index: the scan alone decides
     if (up == kNoNode) return kNone;  // every ancestor was probed: none has an entry
     const std::uint32_t owner = node_owner_[up];
     if (owner != kNone) {
@@ -156,6 +163,7 @@ std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_
 }
 
 void DpMap::index_insert(std::uint32_t e) {
+  if (index_ == nullptr) return;
   std::uint32_t i = index_home(obs_[e].owner, obs_[e].location);
   while (index_[i] != kNone) i = (i + 1U) & index_mask_;
   index_[i] = e;
@@ -164,6 +172,7 @@ void DpMap::index_insert(std::uint32_t e) {
 // Backward-shift deletion (linear probing without tombstones): later members of the
 // probe run move into the hole unless their home lies cyclically in (hole, position].
 void DpMap::index_erase(std::uint32_t e) {
+  if (index_ == nullptr) return;
   std::uint32_t i = index_home(obs_[e].owner, obs_[e].location);
   while (index_[i] != e) i = (i + 1U) & index_mask_;
   std::uint32_t j = i;
@@ -516,8 +525,8 @@ bool DpMap::invariants_hold() const {
   }
   if (tiles_seen != tiles_pool_.size() || in_cells != obs_total) return false;
   // Index: exactly one slot per observation (each findable, checked above).
-  std::uint32_t indexed = 0U;
-  for (std::size_t i = 0U; i <= index_mask_; ++i) {
+  std::uint32_t indexed = index_ == nullptr ? obs_total : 0U;
+  for (std::size_t i = 0U; index_ != nullptr && i <= index_mask_; ++i) {
     const std::uint32_t e = index_[i];
     if (e == kNone) continue;
     if (!obs_pool_.slot_in_use(e) || ++indexed > obs_total) return false;

@@ -31,6 +31,7 @@ DpMap::Options map_options(const DpSlamOptions& o) {
   m.resolution_m = o.map_resolution_m;
   m.tile_capacity = o.tile_capacity();
   m.observation_capacity = o.observation_capacity();
+  m.owner_cell_index = o.map_owner_cell_index;
   return m;
 }
 

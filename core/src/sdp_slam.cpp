@@ -94,6 +94,9 @@ DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const Sdp
     b.map_observations_base = sdp.map_observation_capacity;
     b.map_observations_per_particle = 1U;
   }
+  // Few particles per segment: the DP map's (owner, cell) index would cost a third of the
+  // memory budget for little time (the index is for DP-SLAM at hundreds of particles).
+  b.map_owner_cell_index = sdp.map_owner_cell_index;
   return b;
 }
 

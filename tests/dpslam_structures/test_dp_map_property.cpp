@@ -47,12 +47,19 @@ struct Scenario {
   std::uint32_t tile_capacity;
   std::uint32_t observation_capacity;
   std::uint64_t seed;
+  bool owner_cell_index = true;
 };
+
+DpMap::Options scenario_options(const Scenario& s) {
+  DpMap::Options o = small_options(s.tile_capacity, s.observation_capacity);
+  o.owner_cell_index = s.owner_cell_index;
+  return o;
+}
 
 class PropertyRun {
  public:
   explicit PropertyRun(const Scenario& s)
-      : s_(s), f_(3U * s.particles, 4096U, small_options(s.tile_capacity, s.observation_capacity)), rng_(s.seed) {
+      : s_(s), f_(3U * s.particles, 4096U, scenario_options(s)), rng_(s.seed) {
     w_ = f_.map.width_cells();
     h_ = f_.map.height_cells();
     cells_ = static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_);
@@ -226,6 +233,14 @@ TEST(DpMapProperty, every_particle_view_equals_its_naive_map_copy_and_path) {
   LONGS_EQUAL(0, run.refused());
   LONGS_EQUAL(0, run.fixture().map.observation_oom_count());
   LONGS_EQUAL(0, run.fixture().map.tile_oom_count());
+  CHECK(run.fixture().map.tiles_peak() >= 2U);
+}
+
+// Without the (owner, cell) index every search is the cell-list scan: same views.
+TEST(DpMapProperty, views_equal_the_naive_copies_without_the_owner_cell_index) {
+  PropertyRun run(Scenario{12U, 180U, 6U, 32U, 60000U, 11U, false});
+  run.run();
+  LONGS_EQUAL(0, run.refused());
   CHECK(run.fixture().map.tiles_peak() >= 2U);
 }
 

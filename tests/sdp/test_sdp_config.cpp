@@ -60,6 +60,10 @@ TEST(SdpConfig, enumerated_keys_take_their_names) {
   CHECK(o.segmentation == SegmentationMode::kDispersion);
   CHECK(slam::apply_sdp_key(&o, "accumulation", "mean", &why) == slam::SdpKeyResult::kApplied);
   CHECK(o.accumulation == PgsAccumulation::kMean);
+  CHECK_FALSE(o.map_owner_cell_index);
+  CHECK(slam::apply_sdp_key(&o, "map_owner_cell_index", "true", &why) == slam::SdpKeyResult::kApplied);
+  CHECK_TRUE(o.map_owner_cell_index);
+  CHECK(slam::apply_sdp_key(&o, "map_owner_cell_index", "1", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "elite_fraction", "abc", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "nothing", "1", &why) == slam::SdpKeyResult::kUnknown);
 }

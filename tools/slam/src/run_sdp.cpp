@@ -206,6 +206,11 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "work_cells_per_scan") ok = integer(&t.work_cells_per_scan);
   else if (key == "map_tile_capacity") ok = integer(&t.map_tile_capacity);
   else if (key == "map_observation_capacity") ok = integer(&t.map_observation_capacity);
+  else if (key == "map_owner_cell_index") {
+    if (v == "true") t.map_owner_cell_index = true;
+    else if (v == "false") t.map_owner_cell_index = false;
+    else ok = false;
+  }
   else if (key == "icp_max_iterations") ok = integer(&t.icp.max_iterations);
   else if (key == "icp_max_correspondence_m") ok = real(&t.icp.max_correspondence_m);
   else if (key == "icp_nn_cell_m") ok = real(&t.icp.nn_cell_m);

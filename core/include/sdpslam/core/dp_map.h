@@ -97,6 +97,11 @@ class DpMap final : public TreeListener {
     double resolution_m = 0.05;           // cell side
     std::uint32_t tile_capacity = 0U;     // tiles that may hold data at once
     std::uint32_t observation_capacity = 0U;  // (node, cell) observations at once
+    // The (owner, cell) index (see the top): pays off when a cell holds entries of many
+    // lineages (hundreds of particles) and costs 4 B × index_slots_for() of arena. Off,
+    // every search is the scan of the cell's list (cheap with few particles, e.g. SDP's
+    // bottom level); results are identical either way, only the cost differs.
+    bool owner_cell_index = true;
   };
 
   DpMap() = default;
@@ -270,6 +275,11 @@ class DpMap final : public TreeListener {
   }
   // The observation of `owner` at `location`, kNone if none. O(1) expected.
   std::uint32_t index_find(std::uint32_t owner, std::uint32_t location) const {
+    if (index_ == nullptr) {  // no index: the owner's entry, if any, is in the cell list
+      std::uint32_t e = tiles_[location >> (2U * kSideLog2)].head[location & (capacity::kDpTileCells - 1U)];
+      while (e != kNone && obs_[e].owner != owner) e = obs_[e].next_in_cell;
+      return e;
+    }
     for (std::uint32_t i = index_home(owner, location);; i = (i + 1U) & index_mask_) {
       const std::uint32_t e = index_[i];
       if (e == kNone) return kNone;
@@ -310,7 +320,8 @@ class DpMap final : public TreeListener {
   std::uint32_t* owner_count_ = nullptr;
   std::uint32_t* owner_free_ = nullptr;  // stack of free owners, owner_free_count_ deep
   std::uint32_t owner_free_count_ = 0U;
-  std::uint32_t* index_ = nullptr;  // (owner, location) → observation, kNone = empty slot
+  std::uint32_t* index_ = nullptr;  // (owner, location) → observation, kNone = empty slot;
+                                    // nullptr when Options::owner_cell_index is off
   std::uint32_t index_mask_ = 0U;   // slots − 1
   std::uint32_t index_shift_ = 63U;  // 64 − log2(slots)
   std::uint32_t node_capacity_ = 0U;

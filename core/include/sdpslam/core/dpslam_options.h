@@ -46,6 +46,9 @@ struct DpSlamOptions {
   std::uint32_t map_tile_capacity = 0U;     // 0 = every tile of the area
   std::uint32_t map_observations_base = 2000000U;        // shared (old, committed) map
   std::uint32_t map_observations_per_particle = 20000U;  // each branch's recent cells
+  // DpMap's (owner, cell) index: on for large particle counts (DP-SLAM at hundreds of
+  // particles), off where memory matters more (SDP-SLAM's bottom level). Same results.
+  bool map_owner_cell_index = true;
   // [capacity]
   std::uint32_t ancestry_nodes_per_particle = capacity::kAncestryNodesPerParticle;
   std::uint32_t path_entries_per_particle = 64U;         // uncommitted poses per particle

@@ -68,6 +68,10 @@ struct SdpOptions {
   // tiles that may hold data and observations for every live submap and the global map.
   std::uint32_t map_tile_capacity = 8000U;
   std::uint32_t map_observation_capacity = 1600000U;
+  // [sdp] the DP map's (owner, cell) index (DpMap::Options::owner_cell_index) for the
+  // bottom level: off by default, its ~17 MB would break the memory budget, and with N
+  // bottom particles per segment the cell lists stay short. Results are identical.
+  bool map_owner_cell_index = false;
   // [sdp] ICP (Icp2d options)
   Icp2dOptions icp{};
   // Beyond the paper: the ICP residual alone barely depends on how well the chain placed
