@@ -147,14 +147,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
         ", \"fallback_low_score\": " + u(st.proposal_fallback_low_score) + ", \"evaluations\": " +
         u(st.proposal_evaluations) + "},\n";
   js += "  \"pools\": {\n";
-  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
-        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(st.node_fallback_count) + "},\n";
-  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
-        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
-  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
-        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
-  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
-        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  js += filter_pools_json(*filter);
   js += "    \"map_updates_dropped\": " + u(st.map_updates_dropped) + ",\n";
   js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
   js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";

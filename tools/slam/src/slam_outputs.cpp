@@ -147,10 +147,25 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   return known_cells;
 }
 
+std::string filter_pools_json(const DpSlamFilter& filter) {
+  const AncestryTree& tree = filter.tree();
+  const DpMap& map = filter.map();
+  auto u = [](std::uint64_t v) { return std::to_string(v); };
+  std::string js;
+  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
+        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(filter.stats().node_fallback_count) + "},\n";
+  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
+        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
+  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
+        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
+  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
+        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  return js;
+}
+
 std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
                            std::uint64_t path_gaps, std::uint32_t known_cells) {
   const DpSlamFilter& bottom = slam.bottom();
-  const AncestryTree& tree = bottom.tree();
   const DpMap& map = bottom.map();
   const DpSlamStats& bs = bottom.stats();
   const SdpStats& st = slam.stats();
@@ -171,14 +186,7 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
         ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
   js += "  \"pools\": {\n";
-  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
-        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(bs.node_fallback_count) + "},\n";
-  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
-        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
-  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
-        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
-  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
-        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  js += filter_pools_json(bottom);
   js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +
         ", \"refused\": " + u(st.pgs_refused) + "},\n";
   js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +

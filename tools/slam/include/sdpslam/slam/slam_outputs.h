@@ -64,6 +64,11 @@ std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const std::vecto
 // a time): an output step, not a per-scan one.
 std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image);
 
+// The bottom filter's pool members of a stats.json "pools" object (ancestry nodes, path
+// entries, observations, tiles: capacity, peak, exhausted), one per line indented by four
+// spaces, each ending with ",\n". Shared by the DP-SLAM and SDP-SLAM stats.
+std::string filter_pools_json(const DpSlamFilter& filter);
+
 // The deterministic part of an SDP-SLAM stats.json: "segments" through "memory", one
 // member per line, each line indented by two spaces and ending with ",\n".
 // `arena_bytes` / `arena_used_bytes`: the arena given to init() and its used bytes;
