@@ -2,7 +2,7 @@
 # DP-SLAM baseline benchmark: Intel and ACES at 30, 100 and 400 particles with ONE set
 # of options (tools/slam/default.ini unless CONFIG is given): relations error (mean±std,
 # `sdpslam evaluate`), CPU seconds of the whole run (user+sys from /usr/bin/time: the
-# machine may be shared, so wall time is not the figure), per-scan time p50/p99/max and
+# machine may be shared, so wall time is not the figure), per-scan CPU time p50/p99/max and
 # pool high-water marks from each run's stats.json, peak RSS, and the memory a naive
 # per-particle copy of the best map would take.
 #
@@ -28,7 +28,7 @@ bin="$build/tools/cli/sdpslam"
 [ -x "$bin" ] || { echo "bench_dpslam.sh: no sdpslam binary in $build" >&2; exit 2; }
 mkdir -p "$out"
 summary="$out/summary.tsv"
-printf 'log\tparticles\ttrans_err_m\trot_err_deg\tscans\tprocessed\tcpu_s\tscan_ms_p50\tscan_ms_p99\tscan_ms_max\tnodes_peak\tobs_peak\ttiles_peak\tstate_bytes\tnaive_copy_bytes\tpeak_rss_kib\n' > "$summary"
+printf 'log\tparticles\ttrans_err_m\trot_err_deg\tscans\tprocessed\tcpu_s\tscan_cpu_ms_p50\tscan_cpu_ms_p99\tscan_cpu_ms_max\tnodes_peak\tobs_peak\ttiles_peak\tstate_bytes\tnaive_copy_bytes\tpeak_rss_kib\n' > "$summary"
 field() { sed -n "s/.*\"$1\": \([0-9.e+-]*\).*/\1/p" "$2" | head -1; }
 peak() { sed -n "s/.*\"$1\": {\"capacity\": [0-9]*, \"peak\": \([0-9]*\).*/\1/p" "$2" | head -1; }
 for log in $logs; do
@@ -53,7 +53,7 @@ for log in $logs; do
     s="$dir/stats.json"
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$log" "$n" "${terr:-NA}" "${rerr:-NA}" \
       "$(field scans "$s")" "$(field processed_scans "$s")" "${cpu:-NA}" \
-      "$(field scan_ms_p50 "$s")" "$(field scan_ms_p99 "$s")" "$(field scan_ms_max "$s")" \
+      "$(field scan_cpu_ms_p50 "$s")" "$(field scan_cpu_ms_p99 "$s")" "$(field scan_cpu_ms_max "$s")" \
       "$(peak ancestry_nodes "$s")" "$(peak observations "$s")" "$(peak tiles "$s")" \
       "$(field state_bytes_peak "$s")" "$(field naive_copy_bytes "$s")" "$(field peak_rss_kib "$s")" >> "$summary"
   done

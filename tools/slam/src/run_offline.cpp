@@ -14,6 +14,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
+#include "run_timing.h"
 
 namespace sdpslam::slam {
 namespace {
@@ -24,18 +25,10 @@ class CollectSink final : public PoseSink {
   std::vector<io::StampedPose> poses;
 };
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1U) + 0.5);
-  return v[std::min(idx, v.size() - 1U)];
-}
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
+using detail::fmt;
+using detail::percentile;
+using detail::rusage_cpu_s;
+using detail::thread_cpu_ms;
 
 }  // namespace
 
@@ -66,6 +59,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   std::vector<ScanRecord> scans;
   std::vector<double> scan_ms;
   std::vector<double> processed_ms;
+  std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
   Pose2 last_odom;
   bool have_odom = false;
   std::uint64_t scans_without_odom = 0U;
@@ -90,8 +84,10 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
       continue;
     }
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = thread_cpu_ms();
     const StepResult r = filter->process(od, rec.scan);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    scan_cpu_ms.push_back(thread_cpu_ms() - c0);
     const bool processed = r.status == StepResult::Status::kProcessed;
     scan_ms.push_back(ms);
     if (processed) processed_ms.push_back(ms);
@@ -158,7 +154,11 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
         ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"processed_ms_p50\": " +
         fmt("%.3f", percentile(processed_ms, 0.5)) + ", \"processed_ms_p99\": " +
         fmt("%.3f", percentile(processed_ms, 0.99)) + ", \"processed_ms_max\": " +
-        fmt("%.3f", percentile(processed_ms, 1.0)) + ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) +
+        fmt("%.3f", percentile(processed_ms, 1.0)) + ", \"scan_cpu_ms_p50\": " +
+        fmt("%.3f", percentile(scan_cpu_ms, 0.5)) + ", \"scan_cpu_ms_p99\": " +
+        fmt("%.3f", percentile(scan_cpu_ms, 0.99)) + ", \"scan_cpu_ms_max\": " +
+        fmt("%.3f", percentile(scan_cpu_ms, 1.0)) + ", \"cpu_time_s\": " +
+        fmt("%.3f", rusage_cpu_s(ru)) + ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) +
         "}\n}\n";
   if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return RunStatus::kIoError;
 

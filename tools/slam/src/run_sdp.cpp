@@ -19,6 +19,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
+#include "run_timing.h"
 
 namespace sdpslam::slam {
 namespace {
@@ -85,24 +86,10 @@ class Rows final : public TopLevelListener {
   std::vector<Row> rows;
 };
 
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1U) + 0.5);
-  return v[std::min(idx, v.size() - 1U)];
-}
-
-std::string fmt(const char* f, double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
+using detail::fmt;
+using detail::percentile;
+using detail::rusage_cpu_s;
+using detail::thread_cpu_ms;
 
 // Line plot of the per-round ICP error (mean, with a ±std band), rasterised on an
 // occupancy canvas: white background, black axes, grey band, the mean drawn in colour
@@ -376,7 +363,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
         fmt("%.3f", percentile(segment_ms, 1.0)) + ", \"scan_cpu_ms_p50\": " + fmt("%.3f", percentile(scan_cpu_ms, 0.5)) +
         ", \"scan_cpu_ms_p99\": " + fmt("%.3f", percentile(scan_cpu_ms, 0.99)) + ", \"scan_cpu_ms_max\": " +
         fmt("%.3f", percentile(scan_cpu_ms, 1.0)) + ", \"cpu_time_s\": " +
-        fmt("%.3f", static_cast<double>(ru.ru_utime.tv_sec) + static_cast<double>(ru.ru_utime.tv_usec) * 1e-6) +
+        fmt("%.3f", rusage_cpu_s(ru)) +
         ", \"scan_cpu_ms_max_segmentation\": " + fmt("%.3f", cpu_max_by_kind[0]) +
         ", \"scan_cpu_ms_max_evaluation\": " + fmt("%.3f", cpu_max_by_kind[1]) +
         ", \"scan_cpu_ms_max_anchorage\": " + fmt("%.3f", cpu_max_by_kind[2]) +
