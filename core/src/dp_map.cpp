@@ -377,52 +377,37 @@ void DpMap::merge_node(NodeId parent, NodeId child) {
   if (oc == kNone || owner_count_[op] > owner_count_[oc]) {
     // The child's side is smaller: fold it into the parent's owner, then hand that owner
     // to the child. A fresh particle (no observations) makes this O(1).
-    if (oc != kNone) {
-      std::uint32_t e = owner_head_[oc];
-      while (e != kNone) {
-        Observation& o = obs_[e];
-        const std::uint32_t next = o.next_in_node;
-        const std::uint32_t f = index_find(op, o.location);  // P's entry in this cell
-        if (f != kNone) {
-          obs_[f].value = o.value;  // C's record is newer: it survives in P's slot
-          release_observation(e);   // the tile keeps f, so it stays
-        } else {
-          index_erase(e);
-          o.owner = op;
-          index_insert(e);
-          o.next_in_node = owner_head_[op];
-          owner_head_[op] = e;
-          ++owner_count_[op];
-        }
-        e = next;
-      }
-      owner_head_[oc] = kNone;
-      release_owner(oc);
-    }
+    if (oc != kNone) fold_owner(oc, op, true);  // C's records are newer
     node_owner_[parent] = kNone;
     owner_node_[op] = child;
     node_owner_[child] = op;
     return;
   }
   // The parent's side is not larger: move it into the child's owner.
-  std::uint32_t e = owner_head_[op];
+  fold_owner(op, oc, false);  // the child's own records are newer and shadow P's
+}
+
+void DpMap::fold_owner(std::uint32_t from, std::uint32_t into, bool from_is_newer) {
+  std::uint32_t e = owner_head_[from];
   while (e != kNone) {
     Observation& o = obs_[e];
     const std::uint32_t next = o.next_in_node;
-    if (index_find(oc, o.location) != kNone) {
-      release_observation(e);  // the child's own record is newer and shadows it
+    const std::uint32_t f = index_find(into, o.location);  // `into`'s entry in this cell
+    if (f != kNone) {
+      if (from_is_newer) obs_[f].value = o.value;  // the newer record survives in f's slot
+      release_observation(e);                      // the tile keeps f, so it stays
     } else {
       index_erase(e);
-      o.owner = oc;
+      o.owner = into;
       index_insert(e);
-      o.next_in_node = owner_head_[oc];
-      owner_head_[oc] = e;
-      ++owner_count_[oc];
+      o.next_in_node = owner_head_[into];
+      owner_head_[into] = e;
+      ++owner_count_[into];
     }
     e = next;
   }
-  owner_head_[op] = kNone;
-  release_owner(op);
+  owner_head_[from] = kNone;
+  release_owner(from);
 }
 
 void DpMap::location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const {

@@ -144,6 +144,8 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
                   capacity::kMaxPgsNodesPerLevel);
     return false;
   }
+  // The bottom filter, ICP and segmenter live in the arena: placement new below (init
+  // only) constructs them there; nothing comes from the heap (tests/sdp/test_sdp_no_heap).
   void* fmem = arena.allocate(sizeof(DpSlamFilter), alignof(DpSlamFilter));
   void* imem = arena.allocate(sizeof(Icp2d), alignof(Icp2d));
   void* smem = arena.allocate(sizeof(Segmenter), alignof(Segmenter));

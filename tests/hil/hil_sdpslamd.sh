@@ -76,16 +76,8 @@ echo "HIL sdpslamd test: $((end - start)) s in the machine (boot to power-off)"
 [ $got = 1 ] || { echo "FAIL: the outputs did not come out of the machine"; exit 1; }
 grep -q '"rx_overflows": 0' "$work/status.json" || { echo "FAIL: CAN frames lost"; exit 1; }
 grep -q '"dropped_total": 0' "$work/status.json" || { echo "FAIL: sdpslamd skipped or dropped scans"; exit 1; }
-placed=$(sed -n 's/.*"placed": \([0-9]*\).*/\1/p' "$work/status.json")
-recorded=$(grep -c '^ROBOTLASER1 ' "$work/out/input.clf")
-[ "$placed" = "$recorded" ] && [ "$placed" -gt 0 ] || { echo "FAIL: $placed scans placed but $recorded recorded"; exit 1; }
-"$sdpslam" run "$work/out/input.clf" --mode dpslam --config "$work/offline.ini" --seed 1 --out "$work/recorded" \
-  2>"$work/recorded.log" || { cat "$work/recorded.log"; echo "FAIL: sdpslam run on the recording failed"; exit 1; }
-grep -q '"log_errors": 0' "$work/recorded/stats.json" || { echo "FAIL: the recording has unreadable lines"; exit 1; }
-for f in trajectory.txt map.pgm; do
-  cmp "$work/out/$f" "$work/recorded/$f" || { echo "FAIL: $f of sdpslamd (machine) and of sdpslam run on its recording differ"; exit 1; }
-done
-echo "exact: sdpslam run on the machine's input.clf reproduces sdpslamd's trajectory.txt ($placed scans) and map.pgm byte for byte"
+sh "$here/../sdpslamd/check_recording.sh" "$sdpslam" "$work/out" "$work/status.json" "$work/offline.ini" dpslam 5 \
+  "$work/recorded" machine || exit 1
 set -- $(sed -n 's/^timeline: play_start_us \([0-9]*\) log_start_us \([0-9]*\) speed \(.*\)/\1 \2 \3/p' "$work/console.txt")
 [ -n "$fidelity" ] && { "$fidelity" "$work/log.dat" "$work/out/input.clf" "$1" "$2" "$3" || echo "note: fidelity comparison incomplete"; }
 printf 'against the original log (figure): '

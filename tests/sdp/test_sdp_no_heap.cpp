@@ -22,6 +22,24 @@ class CountingListener final : public TopLevelListener {
 
 TEST_GROUP(SdpNoHeap){};
 
+// init() builds its objects (bottom filter, ICP, segmenter, PGS) by placement new in the
+// caller's arena: with the arena's buffer allocated beforehand, init itself allocates
+// nothing either.
+TEST(SdpNoHeap, init_builds_everything_in_the_arena) {
+  CHECK_TRUE(sdpslam::test::allocation_counting_active());
+  const DpSlamOptions b = test::sim_options(5);
+  const SdpOptions s = test::small_sdp_options();
+  std::vector<unsigned char> buffer(SdpSlam::required_arena_bytes(b, s), 0);
+  Arena arena;
+  auto slam = std::make_unique<SdpSlam>();
+  {
+    sdpslam::test::AllocationScope scope;
+    arena.reset(buffer.data(), buffer.size());
+    CHECK_TRUE(slam->init(b, s, arena, 9));
+    LONGS_EQUAL(0, scope.allocations());
+  }
+}
+
 TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) {
   CHECK_TRUE(sdpslam::test::allocation_counting_active());
   const test::ScanSet set(3);

@@ -95,17 +95,9 @@ grep -o '"from_scan_stamp": {[^}]*}' "$work/daemon/status.json"
 grep -o '"cpu": {[^}]*}' "$work/daemon/status.json"
 grep -o '"input_log": {[^}]*}' "$work/daemon/status.json"
 grep -q '"dropped_total": 0' "$work/daemon/status.json" || { echo "FAIL: sdpslamd dropped scans"; exit 1; }
-placed=$(sed -n 's/.*"placed": \([0-9]*\).*/\1/p' "$work/daemon/status.json")
-recorded=$(grep -c '^ROBOTLASER1 ' "$work/daemon/input.clf")
-[ "$placed" = "$recorded" ] && [ "$placed" -gt 0 ] || { echo "FAIL: $placed scans placed but $recorded recorded"; exit 1; }
 # Exact: the offline runner on sdpslamd's recorded input.
-# The offline runner takes sdp's bottom particle count from --particles, not [filter].
-"$sdpslam" run "$work/daemon/input.clf" --mode "$mode" --particles 5 --config "$work/offline.ini" --seed 1 --out "$work/recorded" \
-  2>"$work/recorded.log" || { cat "$work/recorded.log"; echo "FAIL: sdpslam run on the recording failed"; exit 1; }
-grep -q '"log_errors": 0' "$work/recorded/stats.json" || { echo "FAIL: the recording has unreadable lines"; exit 1; }
-for f in trajectory.txt map.pgm; do
-  cmp "$work/daemon/$f" "$work/recorded/$f" || { echo "FAIL: $f of sdpslamd and of sdpslam run on its recording differ"; exit 1; }
-done
+sh "$(dirname "$0")/check_recording.sh" "$sdpslam" "$work/daemon" "$work/daemon/status.json" "$work/offline.ini" \
+  "$mode" 5 "$work/recorded" host || exit 1
 if [ "$mode" = sdp ]; then
   segs=$(sed -n 's/^  "segments": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
   grep -q "\"segments\": $segs," "$work/recorded/stats.json" || { echo "FAIL: segment counts differ"; exit 1; }
@@ -114,7 +106,6 @@ if [ "$mode" = sdp ]; then
   [ "${perm:-0}" -ge 1 ] || { echo "FAIL: no level became permanent: the test no longer exercises that path"; exit 1; }
   echo "segments: $segs, levels made permanent: $perm (sdpslamd and sdpslam run alike)"
 fi
-echo "exact ($mode): sdpslam run on input.clf reproduces sdpslamd's trajectory.txt ($(grep -vc '^#' "$work/daemon/trajectory.txt") poses) and map.pgm byte for byte"
 # Figures: the replay against the original log.
 set -- $(sed -n 's/^timeline: play_start_us \([0-9]*\) log_start_us \([0-9]*\) speed \(.*\)/\1 \2 \3/p' "$work/replay.log")
 [ -n "$fidelity" ] && { "$fidelity" "$work/log.dat" "$work/daemon/input.clf" "$1" "$2" "$3" || echo "note: fidelity comparison incomplete"; }

@@ -14,7 +14,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
-#include "run_timing.h"
+#include "run_common.h"
 
 namespace sdpslam::slam {
 namespace {
@@ -60,29 +60,10 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   std::vector<double> scan_ms;
   std::vector<double> processed_ms;
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
-  Pose2 last_odom;
-  bool have_odom = false;
-  std::uint64_t scans_without_odom = 0U;
-  for (;;) {
-    const io::LogReader::Next k = reader.next();
-    if (k == io::LogReader::Next::kEnd) break;
-    if (k == io::LogReader::Next::kOdom) {
-      last_odom = reader.odom().pose;
-      have_odom = true;
-      continue;
-    }
-    if (k != io::LogReader::Next::kLaser) continue;
+  detail::ScanOdometryPairing pairing;
+  OdometrySample od;
+  while (pairing.next(reader, &od)) {
     const io::LaserRecord& rec = reader.laser();
-    OdometrySample od;
-    od.stamp_us = rec.stamp_us;
-    if (rec.has_odom_pose) {
-      od.pose = rec.odom_pose;
-    } else if (have_odom) {
-      od.pose = last_odom;
-    } else {
-      ++scans_without_odom;  // no odometry yet: such a scan cannot be placed
-      continue;
-    }
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
     const StepResult r = filter->process(od, rec.scan);
@@ -135,7 +116,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   js += "  \"log\": \"" + log_path + "\",\n";
   js += "  \"mode\": \"dpslam\",\n  \"particles\": " + u(fo.particle_count) + ",\n  \"seed\": " + u(options.seed) + ",\n";
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(st.processed) + ",\n";
-  js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
+  js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
   js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
   js += "  \"proposal\": {\"matched\": " + u(st.proposal_matched) + ", \"fallback_few_beams\": " +

@@ -19,7 +19,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
-#include "run_timing.h"
+#include "run_common.h"
 
 namespace sdpslam::slam {
 namespace {
@@ -270,29 +270,10 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
   double cpu_max_by_kind[4] = {0.0, 0.0, 0.0, 0.0};
   std::vector<double> segment_ms;
-  Pose2 last_odom;
-  bool have_odom = false;
-  std::uint64_t scans_without_odom = 0U;
-  for (;;) {
-    const io::LogReader::Next k = reader.next();
-    if (k == io::LogReader::Next::kEnd) break;
-    if (k == io::LogReader::Next::kOdom) {
-      last_odom = reader.odom().pose;
-      have_odom = true;
-      continue;
-    }
-    if (k != io::LogReader::Next::kLaser) continue;
+  detail::ScanOdometryPairing pairing;
+  OdometrySample od;
+  while (pairing.next(reader, &od)) {
     const io::LaserRecord& rec = reader.laser();
-    OdometrySample od;
-    od.stamp_us = rec.stamp_us;
-    if (rec.has_odom_pose) {
-      od.pose = rec.odom_pose;
-    } else if (have_odom) {
-      od.pose = last_odom;
-    } else {
-      ++scans_without_odom;
-      continue;
-    }
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
     const SdpStepResult r = slam->process(od, rec.scan);
@@ -354,7 +335,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js += "  \"top_particles\": " + u(so.top_particles) + ",\n  \"bottom_particles\": " + u(fo.particle_count) +
         ",\n  \"seed\": " + u(options.seed) + ",\n";
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(bs.processed) + ",\n";
-  js += "  \"scans_without_odometry\": " + u(scans_without_odom) + ",\n";
+  js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
   js += sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells);
   js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +

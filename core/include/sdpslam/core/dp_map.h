@@ -286,6 +286,10 @@ class DpMap final : public TreeListener {
       if (obs_[e].owner == owner && obs_[e].location == location) return e;
     }
   }
+  // Moves every entry of owner `from` to owner `into` and frees `from`. Where `into`
+  // already has an entry in the cell, one record survives in `into`'s slot: `from`'s
+  // value if `from_is_newer`, else `into`'s; the other entry is released.
+  void fold_owner(std::uint32_t from, std::uint32_t into, bool from_is_newer);
   void index_insert(std::uint32_t e);
   void index_erase(std::uint32_t e);
   // New entry of `particle` (live, no entry in this cell yet) in cell `c` of tile-table

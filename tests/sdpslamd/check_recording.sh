@@ -1,0 +1,20 @@
+#!/bin/sh
+# The exact check shared by the host and in-machine sdpslamd tests:
+#   check_recording.sh SDPSLAM OUT_DIR STATUS_JSON CONFIG MODE PARTICLES RECORDED_DIR WHERE
+# sdpslamd wrote OUT_DIR/input.clf (every scan it handed to SLAM), trajectory.txt and
+# map.pgm. Checks that one line was recorded per placed scan (STATUS_JSON "placed") and
+# that `sdpslam run` on the recording, with the same options (CONFIG, MODE, PARTICLES:
+# the offline runner takes sdp's bottom particle count from --particles, not [filter])
+# and seed 1, writes a byte-identical trajectory.txt and map.pgm into RECORDED_DIR.
+# WHERE names the run in messages. Exit 0 iff all of that holds.
+sdpslam=$1 out=$2 status=$3 config=$4 mode=$5 particles=$6 recorded=$7 where=$8
+placed=$(sed -n 's/.*"placed": \([0-9]*\).*/\1/p' "$status")
+lines=$(grep -c '^ROBOTLASER1 ' "$out/input.clf")
+[ "$placed" = "$lines" ] && [ "$placed" -gt 0 ] || { echo "FAIL: $placed scans placed but $lines recorded"; exit 1; }
+"$sdpslam" run "$out/input.clf" --mode "$mode" --particles "$particles" --config "$config" --seed 1 --out "$recorded" \
+  2>"$recorded.log" || { cat "$recorded.log"; echo "FAIL: sdpslam run on the recording failed"; exit 1; }
+grep -q '"log_errors": 0' "$recorded/stats.json" || { echo "FAIL: the recording has unreadable lines"; exit 1; }
+for f in trajectory.txt map.pgm; do
+  cmp "$out/$f" "$recorded/$f" || { echo "FAIL: $f of sdpslamd ($where) and of sdpslam run on its recording differ"; exit 1; }
+done
+echo "exact ($mode, $where): sdpslam run on input.clf reproduces sdpslamd's trajectory.txt ($placed scans) and map.pgm byte for byte"
