@@ -19,14 +19,17 @@ if(SDPSLAM_SANITIZE)
 endif()
 
 # sdpslam_add_test(NAME <name> SOURCES <src...> [LIBS <lib...>] [LABELS <label...>]
-#                  [NEEDS_SHARED] [NO_SANITIZE])
+#                  [NEEDS_SHARED] [NO_SANITIZE] [REALTIME])
 # Builds one CppUTest executable (with the common main in tests/support) and registers
 # it with CTest. Under a cross build CTest runs it through CMAKE_CROSSCOMPILING_EMULATOR.
 # NEEDS_SHARED: the test reads ../shared; when that folder is absent the test prints
 #   why and exits 77, which CTest reports as skipped.
 # NO_SANITIZE: the test replaces malloc (allocation counting) and cannot run under ASan.
+# REALTIME: the test drives threads against the wall clock (ptys, sockets, players);
+#   it runs alone (RUN_SERIAL), so the suite's own CPU-bound tests cannot starve it, and
+#   carries the label `realtime` (see sdpslam_realtime_test()).
 function(sdpslam_add_test)
-  cmake_parse_arguments(T "NEEDS_SHARED;NO_SANITIZE" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "NEEDS_SHARED;NO_SANITIZE;REALTIME" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   # tests/ is also entered for fuzzers (fuzz preset: SDPSLAM_BUILD_TESTS=OFF), where the
   # CppUTest support and allocation-counter targets do not exist.
   if(NOT SDPSLAM_BUILD_TESTS)
@@ -57,6 +60,24 @@ function(sdpslam_add_test)
   if(T_TIMEOUT)
     set_tests_properties(${T_NAME} PROPERTIES TIMEOUT ${T_TIMEOUT})
   endif()
+  if(T_REALTIME)
+    sdpslam_realtime_test(${T_NAME})
+  endif()
+endfunction()
+
+# sdpslam_realtime_test(<test>...): the tests run one at a time with nothing else from
+# the suite beside them (on a 2-core machine two sanitizer-built filter tests leave a
+# real-time thread waiting for 100 ms and more) and gain the label `realtime`
+# (`ctest -L realtime` runs just them).
+function(sdpslam_realtime_test)
+  foreach(t IN LISTS ARGN)
+    get_test_property(${t} LABELS labels)
+    if(NOT labels)
+      set(labels "")
+    endif()
+    list(APPEND labels realtime)
+    set_tests_properties(${t} PROPERTIES RUN_SERIAL TRUE LABELS "${labels}")
+  endforeach()
 endfunction()
 
 # sdpslam_add_fuzzer(NAME <name> SOURCES <src...> [LIBS <lib...>] [SECONDS <n>] [CORPUS <dir>])

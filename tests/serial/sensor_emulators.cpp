@@ -85,15 +85,23 @@ std::uint64_t PtyDevice::now_ms() const {
 }
 
 void PtyDevice::send(const std::uint8_t* data, std::size_t n) {
+  // A full slave input queue means the driver is behind (a loaded machine can hold its
+  // thread off for 100 ms and more): wait for it rather than cut the message, which would
+  // look like a line fault to the driver. Give up only after 2 s without progress.
   std::size_t sent = 0;
-  for (int tries = 0; sent < n && master_ >= 0 && tries < 200; ++tries) {
+  int idle_polls = 0;
+  while (sent < n && master_ >= 0 && running_) {
     const ssize_t w = ::write(master_, data + sent, n - sent);
     if (w > 0) {
       sent += static_cast<std::size_t>(w);
+      idle_polls = 0;
+    } else if (++idle_polls > 4000) {
+      break;
     } else {
-      ::usleep(500);  // slave input queue full: the driver is behind
+      ::usleep(500);
     }
   }
+  if (sent < n) ++sends_cut_;
 }
 
 void PtyDevice::run() {

@@ -24,6 +24,8 @@ class PtyDevice {
   void replug();
   const std::string& link_path() const { return link_; }
   int slave_fd() const { return slave_; }
+  // Writes given up part-way because the driver read nothing for 2 s (a cut message).
+  std::uint32_t sends_cut() const { return sends_cut_.load(); }
 
  protected:
   virtual void on_bytes(const std::uint8_t* data, std::size_t n) = 0;
@@ -42,6 +44,7 @@ class PtyDevice {
   int slave_ = -1;
   std::mutex mutex_;
   std::atomic<bool> running_{false};
+  std::atomic<std::uint32_t> sends_cut_{0U};
   std::thread thread_;
 };
 

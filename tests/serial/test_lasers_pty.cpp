@@ -129,6 +129,7 @@ TEST(UrgLaserPty, streams_exact_scans_with_geometry_from_pp_at_750000_baud) {
   UrgRig rig("urg", 750000U, urg_options());
   CHECK(rig.collect(5, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(0, missing(rig.ids));
   LONGS_EQUAL(750000, sdpslam::drivers::tty_baud_rate(rig.port.fd()));
   DOUBLES_EQUAL(-2.0862, rig.scan.geometry.angle_min_rad, 1e-4);
@@ -144,6 +145,7 @@ TEST(UrgLaserPty, stamps_increase_steadily_across_the_24_bit_timestamp_wrap) {
   UrgRig rig("urgwrap", 115200U, urg_options());
   CHECK(rig.collect(45, 5000000, urg_scan_id));  // the emulator's counter wraps at scan 30
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   for (std::size_t i = 1; i < rig.stamps.size(); ++i) {
     const std::int64_t d = rig.stamps[i] - rig.stamps[i - 1];
     CHECK(d > 0);
@@ -158,6 +160,7 @@ TEST(UrgLaserPty, corrupted_data_byte_drops_exactly_that_scan_as_checksum_error)
   rig.emu.inject(UrgEmulator::kCorruptData);
   CHECK(rig.collect(5, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
   LONGS_EQUAL(1, rig.laser.stats().checksum_error_count);
   LONGS_EQUAL(1, rig.laser.stats().dropped_scan_count);
@@ -169,6 +172,7 @@ TEST(UrgLaserPty, truncated_line_drops_exactly_that_scan) {
   rig.emu.inject(UrgEmulator::kTruncateLine);
   CHECK(rig.collect(5, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
   LONGS_EQUAL(1, rig.laser.stats().dropped_scan_count);
   LONGS_EQUAL(1, rig.laser.stats().checksum_error_count + rig.laser.stats().framing_error_count);
@@ -180,6 +184,7 @@ TEST(UrgLaserPty, lost_data_line_is_a_value_count_framing_error) {
   rig.emu.inject(UrgEmulator::kDropLine);
   CHECK(rig.collect(5, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
   LONGS_EQUAL(1, rig.laser.stats().framing_error_count);
   LONGS_EQUAL(0, rig.laser.stats().checksum_error_count);
@@ -192,6 +197,7 @@ TEST(UrgLaserPty, random_garbage_is_skipped_and_streaming_resumes_at_the_next_re
   rig.emu.inject(UrgEmulator::kGarbage);
   CHECK(rig.collect(5, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   CHECK(missing(rig.ids) <= 1);  // garbage glued to the next echo costs that scan
   CHECK(rig.laser.stats().garbage_byte_count > 0);
   CHECK(rig.laser.stats().resync_count >= 1);
@@ -211,6 +217,7 @@ TEST(UrgLaserPty, unplug_is_seen_as_hangup_and_replug_restarts_streaming) {
   rig.emu.replug();
   CHECK(rig.collect(3, 3000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(2, rig.port.stats().open_count);
   LONGS_EQUAL(750000, sdpslam::drivers::tty_baud_rate(rig.port.fd()));
   LONGS_EQUAL(1, rig.laser.stats().restart_count);
@@ -223,6 +230,7 @@ TEST(SickLaserPty, switches_scanner_and_host_to_500000_baud_and_streams_exact_sc
   SickRig rig("sick", 9600U, sick_options(500000U));
   CHECK(rig.collect(5, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(0, missing(rig.ids));
   LONGS_EQUAL(500000, rig.emu.baud());
   LONGS_EQUAL(500000, rig.port.baud_rate());
@@ -241,6 +249,7 @@ TEST(SickLaserPty, corrupted_telegram_fails_crc_and_only_that_scan_is_lost) {
   rig.emu.inject(SickEmulator::kCorruptCrc);
   CHECK(rig.collect(5, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
   CHECK(rig.laser.stats().checksum_error_count >= 1);
   CHECK(rig.laser.stats().dropped_scan_count >= 1);
@@ -252,6 +261,7 @@ TEST(SickLaserPty, truncated_telegram_is_lost_and_the_next_one_is_recovered_by_r
   rig.emu.inject(SickEmulator::kTruncateTelegram);
   CHECK(rig.collect(5, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
   CHECK(rig.laser.stats().checksum_error_count >= 1);
   CHECK(rig.laser.stats().resync_count >= 1);
@@ -263,6 +273,7 @@ TEST(SickLaserPty, garbage_with_false_stx_bytes_costs_no_scan) {
   rig.emu.inject(SickEmulator::kGarbage);
   CHECK(rig.collect(5, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(0, missing(rig.ids));
   CHECK(rig.laser.stats().garbage_byte_count >= 40);
   CHECK(rig.laser.stats().resync_count >= 1);
@@ -273,6 +284,7 @@ TEST(SickLaserPty, nak_is_counted_and_the_request_is_resent) {
   rig.emu.inject(SickEmulator::kNakNextRequest);
   CHECK(rig.collect(3, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, rig.emu.naks_sent());
   LONGS_EQUAL(1, rig.laser.stats().nak_count);
 }
@@ -288,6 +300,7 @@ TEST(SickLaserPty, unplug_and_replug_of_a_power_cycled_scanner_restarts_at_9600)
   rig.emu.replug();
   CHECK(rig.collect(3, 3000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(2, rig.port.stats().open_count);
   LONGS_EQUAL(500000, rig.emu.baud());
   LONGS_EQUAL(1, rig.laser.stats().restart_count);
