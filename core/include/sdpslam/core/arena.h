@@ -41,6 +41,13 @@ class Arena {
     return reinterpret_cast<void*>(aligned);
   }
 
+  // Bytes to budget for allocate_array<T>(count): the array, its worst alignment padding
+  // and a margin (for required_arena_bytes() functions summing many arrays).
+  template <typename T>
+  static constexpr std::size_t bytes_for(std::size_t count) {
+    return sizeof(T) * count + alignof(T) + 64U;
+  }
+
   // Typed array of `count` default-initialised Ts; nullptr iff out of room.
   template <typename T>
   T* allocate_array(std::size_t count) {

@@ -1,0 +1,122 @@
+#pragma once
+// A bounded pose graph over submap frames, for loop closure in SDP-SLAM (beyond the
+// paper: its top level only weights combinations by their ICP error; the correction ICP
+// finds between two overlapping non-adjacent submaps is thrown away, so drift along a
+// loop stays in the chain however well the loop matches). Here those corrections become
+// constraints and the frames of the chosen chain are adjusted to agree with them, the
+// way graph-based SLAM closes loops (Lu & Milios 1997; Grisetti et al., "A tutorial on
+// graph-based SLAM", 2010, §IV for the SE(2) error and Jacobians used below).
+//
+// Nodes are the global frames X_k of consecutive submaps (k = 0 .. n-1); node 0 is held
+// fixed (the gauge). Every node k >= 1 has a SEQUENTIAL constraint to node k-1 (Z = the
+// chain's own transform T_(k-1)k, Fig. 3 (l)); LOOP constraints join any two nodes with
+// the relative pose ICP found. The error of a constraint (i, j, Z, Ω) is
+//   e = t2v(Z⁻¹ ⊕ (X_i⁻¹ ⊕ X_j)),  cost ½ eᵀ Ω e,  Ω = diag(1/σ_xy², 1/σ_xy², 1/σ_θ²).
+// Loop constraints pass through a Cauchy kernel (weight 1 / (1 + χ²/c²), χ² = eᵀΩe,
+// recomputed every Gauss-Newton step), so a wrong match that disagrees with the rest
+// pulls little.
+//
+// Solver: Gauss-Newton on the poses (additive update of x, y, θ). Each step solves
+// H Δ = -b by preconditioned conjugate gradients; H is never formed, H·v is summed over
+// the constraints. The preconditioner is H without the loop constraints' off-diagonal
+// blocks: block-tridiagonal (the chain), factorised exactly in O(n) (block LDLᵀ), so CG
+// only has to account for the loops and converges in a few iterations.
+// Cost per step O(n + loops) per CG iteration; memory fixed at init. Deterministic
+// (det:: trigonometry, fixed iteration counts and order).
+#include <cstddef>
+#include <cstdint>
+
+#include "sdpslam/core/arena.h"
+#include "sdpslam/core/pose2.h"
+
+namespace sdpslam {
+
+struct FrameGraphOptions {
+  std::uint32_t max_nodes = 64U;   // frames per solve, >= 2
+  std::uint32_t max_loops = 256U;  // loop constraints per solve, >= 1
+  std::uint32_t iterations = 5U;   // Gauss-Newton steps, >= 1
+  std::uint32_t cg_iterations = 30U;  // conjugate-gradient iterations per step, >= 1
+  double robust_chi = 3.0;  // Cauchy kernel scale on sqrt(χ²) of loop constraints, > 0
+  bool valid() const {
+    return max_nodes >= 2U && max_loops >= 1U && iterations >= 1U && cg_iterations >= 1U && robust_chi > 0.0;
+  }
+};
+
+// Diagonal information of a constraint, from standard deviations.
+struct FrameInfo {
+  double xy = 1.0;     // 1/σ_xy² (1/m²)
+  double theta = 1.0;  // 1/σ_θ² (1/rad²)
+  static FrameInfo from_sigma(double sigma_xy_m, double sigma_theta_rad) {
+    return FrameInfo{1.0 / (sigma_xy_m * sigma_xy_m), 1.0 / (sigma_theta_rad * sigma_theta_rad)};
+  }
+};
+
+struct FrameGraphStats {
+  std::uint64_t solves = 0U;
+  std::uint64_t refused_nodes = 0U;  // add_node beyond max_nodes
+  std::uint64_t refused_loops = 0U;  // add_loop beyond max_loops or with bad indices
+  double last_chi2_before = 0.0;     // objective (chain χ² + Cauchy cost of the loops) before / after the last solve
+  double last_chi2_after = 0.0;
+  std::uint32_t last_downweighted = 0U;  // loops with kernel weight < 0.5 at the end
+};
+
+class FrameGraph {
+ public:
+  static std::size_t required_bytes(const FrameGraphOptions& o);
+  // False iff the options are invalid or the arena is too small.
+  bool init(const FrameGraphOptions& o, Arena& arena);
+
+  // Starts a new graph (keeps the storage).
+  void clear();
+  // Appends node k with its current estimate; for k >= 1 also its sequential
+  // constraint: `from_previous` is the pose of frame k in frame k-1. False when full.
+  bool add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info);
+  // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added). False
+  // when full or the indices are bad.
+  bool add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info);
+  // Gauss-Newton over nodes 1 .. n-1; node 0 stays where it is.
+  void optimise();
+
+  std::uint32_t node_count() const { return n_; }
+  std::uint32_t loop_count() const { return loops_; }
+  const Pose2& frame(std::uint32_t k) const { return pose_[k]; }
+  // Kernel weight of loop constraint l after the last solve (1 = fully trusted).
+  double loop_weight(std::uint32_t l) const { return loop_w_[l]; }
+  const FrameGraphStats& stats() const { return stats_; }
+
+ private:
+  struct Constraint {
+    std::uint32_t i = 0U;
+    std::uint32_t j = 0U;
+    Pose2 z;
+    FrameInfo info;
+  };
+  // Linearised constraint: e, A = ∂e/∂X_i, B = ∂e/∂X_j (row-major 3×3), weight.
+  struct Linear {
+    double e[3];
+    double a[9];
+    double b[9];
+    double w;
+  };
+  void linearise(const Constraint& c, Linear& l) const;
+  double chi2(const Constraint& c) const;
+  void multiply(const double* v, double* out) const;      // out = H v
+  void precondition(const double* r, double* out) const;  // out = M⁻¹ r
+  bool factorise();                                       // M = LDLᵀ (chain)
+
+  FrameGraphOptions options_{};
+  FrameGraphStats stats_{};
+  std::uint32_t n_ = 0U;
+  std::uint32_t loops_ = 0U;
+  Pose2* pose_ = nullptr;           // max_nodes
+  Constraint* seq_ = nullptr;       // max_nodes (seq_[k] joins k-1 and k; seq_[0] unused)
+  Constraint* loop_ = nullptr;      // max_loops
+  double* loop_w_ = nullptr;        // max_loops
+  Linear* lin_ = nullptr;           // max_nodes + max_loops (seq first)
+  double* work_ = nullptr;          // 6 vectors of 3 × max_nodes
+  double* diag_inv_ = nullptr;      // 9 × max_nodes: S_k⁻¹ of the block LDLᵀ
+  double* upper_ = nullptr;         // 9 × max_nodes: U_k = block (k, k+1) of M
+  bool initialised_ = false;
+};
+
+}  // namespace sdpslam

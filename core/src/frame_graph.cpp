@@ -1,0 +1,325 @@
+#include "sdpslam/core/frame_graph.h"
+
+#include "sdpslam/core/det_math.h"
+
+namespace sdpslam {
+namespace {
+
+// Row-major 3×3 helpers.
+void mat_t_mul(const double* a, const double* b, double* out) {  // out = aᵀ b
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out[r * 3 + c] = a[0 * 3 + r] * b[0 * 3 + c] + a[1 * 3 + r] * b[1 * 3 + c] + a[2 * 3 + r] * b[2 * 3 + c];
+  }
+}
+void mat_mul(const double* a, const double* b, double* out) {  // out = a b
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out[r * 3 + c] = a[r * 3 + 0] * b[0 * 3 + c] + a[r * 3 + 1] * b[1 * 3 + c] + a[r * 3 + 2] * b[2 * 3 + c];
+  }
+}
+void mat_vec(const double* a, const double* v, double* out) {
+  for (int r = 0; r < 3; ++r) out[r] = a[r * 3 + 0] * v[0] + a[r * 3 + 1] * v[1] + a[r * 3 + 2] * v[2];
+}
+void mat_t_vec(const double* a, const double* v, double* out) {
+  for (int r = 0; r < 3; ++r) out[r] = a[0 * 3 + r] * v[0] + a[1 * 3 + r] * v[1] + a[2 * 3 + r] * v[2];
+}
+// aᵀ diag(w) b added into out.
+void add_at_w_b(const double* a, const double* w, const double* b, double* out) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      out[r * 3 + c] += a[0 * 3 + r] * w[0] * b[0 * 3 + c] + a[1 * 3 + r] * w[1] * b[1 * 3 + c] + a[2 * 3 + r] * w[2] * b[2 * 3 + c];
+    }
+  }
+}
+// Inverse of a symmetric positive definite 3×3 (adjugate); false if singular.
+bool inverse3(const double* m, double* out) {
+  const double c00 = m[4] * m[8] - m[5] * m[7];
+  const double c01 = m[5] * m[6] - m[3] * m[8];
+  const double c02 = m[3] * m[7] - m[4] * m[6];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  if (!(det > 0.0)) return false;
+  const double inv = 1.0 / det;
+  out[0] = c00 * inv;
+  out[1] = (m[2] * m[7] - m[1] * m[8]) * inv;
+  out[2] = (m[1] * m[5] - m[2] * m[4]) * inv;
+  out[3] = c01 * inv;
+  out[4] = (m[0] * m[8] - m[2] * m[6]) * inv;
+  out[5] = (m[2] * m[3] - m[0] * m[5]) * inv;
+  out[6] = c02 * inv;
+  out[7] = (m[1] * m[6] - m[0] * m[7]) * inv;
+  out[8] = (m[0] * m[4] - m[1] * m[3]) * inv;
+  return true;
+}
+double dot(const double* a, const double* b, std::size_t n) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < n; ++k) s += a[k] * b[k];
+  return s;
+}
+
+}  // namespace
+
+std::size_t FrameGraph::required_bytes(const FrameGraphOptions& o) {
+  if (!o.valid()) return 0U;
+  const std::size_t n = o.max_nodes;
+  const std::size_t l = o.max_loops;
+  return Arena::bytes_for<Pose2>(n) + Arena::bytes_for<Constraint>(n) + Arena::bytes_for<Constraint>(l) + Arena::bytes_for<double>(l) +
+         Arena::bytes_for<Linear>(n + l) + Arena::bytes_for<double>(18U * n) + 2U * Arena::bytes_for<double>(9U * n);
+}
+
+bool FrameGraph::init(const FrameGraphOptions& o, Arena& arena) {
+  if (!o.valid()) return false;
+  options_ = o;
+  const std::size_t n = o.max_nodes;
+  const std::size_t l = o.max_loops;
+  pose_ = arena.allocate_array<Pose2>(n);
+  seq_ = arena.allocate_array<Constraint>(n);
+  loop_ = arena.allocate_array<Constraint>(l);
+  loop_w_ = arena.allocate_array<double>(l);
+  lin_ = arena.allocate_array<Linear>(n + l);
+  work_ = arena.allocate_array<double>(18U * n);
+  diag_inv_ = arena.allocate_array<double>(9U * n);
+  upper_ = arena.allocate_array<double>(9U * n);
+  if (pose_ == nullptr || seq_ == nullptr || loop_ == nullptr || loop_w_ == nullptr || lin_ == nullptr ||
+      work_ == nullptr || diag_inv_ == nullptr || upper_ == nullptr) {
+    return false;
+  }
+  initialised_ = true;
+  clear();
+  return true;
+}
+
+void FrameGraph::clear() {
+  n_ = 0U;
+  loops_ = 0U;
+}
+
+bool FrameGraph::add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info) {
+  if (!initialised_ || n_ >= options_.max_nodes) {
+    ++stats_.refused_nodes;
+    return false;
+  }
+  pose_[n_] = estimate;
+  seq_[n_] = Constraint{n_ > 0U ? n_ - 1U : 0U, n_, from_previous, info};
+  ++n_;
+  return true;
+}
+
+bool FrameGraph::add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info) {
+  if (!initialised_ || loops_ >= options_.max_loops || i >= n_ || j >= n_ || i == j) {
+    ++stats_.refused_loops;
+    return false;
+  }
+  loop_[loops_] = Constraint{i, j, z, info};
+  loop_w_[loops_] = 1.0;
+  ++loops_;
+  return true;
+}
+
+// e = t2v(Z⁻¹ ⊕ X_i⁻¹ ⊕ X_j):
+//   e_t = R_zᵀ (R_iᵀ (t_j − t_i) − t_z),  e_θ = wrap(θ_j − θ_i − θ_z)
+//   A = ∂e/∂(t_i, θ_i) = [ −R_zᵀR_iᵀ   R_zᵀ (∂R_iᵀ/∂θ)(t_j − t_i) ;  0 0 −1 ]
+//   B = ∂e/∂(t_j, θ_j) = [  R_zᵀR_iᵀ   0 ;  0 0 1 ]
+void FrameGraph::linearise(const Constraint& c, Linear& l) const {
+  const Pose2& xi = pose_[c.i];
+  const Pose2& xj = pose_[c.j];
+  const double ci = det::cos(xi.heading_rad), si = det::sin(xi.heading_rad);
+  const double cz = det::cos(c.z.heading_rad), sz = det::sin(c.z.heading_rad);
+  const double dx = xj.x_m - xi.x_m, dy = xj.y_m - xi.y_m;
+  // R_iᵀ d
+  const double lx = ci * dx + si * dy, ly = -si * dx + ci * dy;
+  const double ux = lx - c.z.x_m, uy = ly - c.z.y_m;
+  l.e[0] = cz * ux + sz * uy;
+  l.e[1] = -sz * ux + cz * uy;
+  l.e[2] = normalize_angle_rad(xj.heading_rad - xi.heading_rad - c.z.heading_rad);
+  // R_zᵀ R_iᵀ = rotation by −(θ_z + θ_i)
+  const double cc = cz * ci - sz * si, ss = sz * ci + cz * si;  // cos, sin of θ_z + θ_i
+  const double m00 = cc, m01 = ss, m10 = -ss, m11 = cc;
+  // (∂R_iᵀ/∂θ) d = (−s dx + c dy, −c dx − s dy) = (ly, −lx)
+  const double gx = cz * ly + sz * (-lx), gy = -sz * ly + cz * (-lx);
+  const double a[9] = {-m00, -m01, gx, -m10, -m11, gy, 0.0, 0.0, -1.0};
+  const double b[9] = {m00, m01, 0.0, m10, m11, 0.0, 0.0, 0.0, 1.0};
+  for (int k = 0; k < 9; ++k) {
+    l.a[k] = a[k];
+    l.b[k] = b[k];
+  }
+  l.w = 1.0;
+}
+
+double FrameGraph::chi2(const Constraint& c) const {
+  Linear l;
+  linearise(c, l);
+  return c.info.xy * (l.e[0] * l.e[0] + l.e[1] * l.e[1]) + c.info.theta * l.e[2] * l.e[2];
+}
+
+// H v over nodes 1..n-1 (node 0 is fixed: its entries of v are 0 and of out unused).
+void FrameGraph::multiply(const double* v, double* out) const {
+  for (std::uint32_t k = 0; k < 3U * n_; ++k) out[k] = 0.0;
+  auto edge = [&](const Constraint& c, const Linear& l) {
+    const double w[3] = {l.w * c.info.xy, l.w * c.info.xy, l.w * c.info.theta};
+    double jv[3] = {0.0, 0.0, 0.0};
+    double t[3];
+    if (c.i != 0U) {
+      mat_vec(l.a, v + 3U * c.i, t);
+      for (int r = 0; r < 3; ++r) jv[r] += t[r];
+    }
+    if (c.j != 0U) {
+      mat_vec(l.b, v + 3U * c.j, t);
+      for (int r = 0; r < 3; ++r) jv[r] += t[r];
+    }
+    for (int r = 0; r < 3; ++r) jv[r] *= w[r];
+    if (c.i != 0U) {
+      mat_t_vec(l.a, jv, t);
+      for (int r = 0; r < 3; ++r) out[3U * c.i + static_cast<std::uint32_t>(r)] += t[r];
+    }
+    if (c.j != 0U) {
+      mat_t_vec(l.b, jv, t);
+      for (int r = 0; r < 3; ++r) out[3U * c.j + static_cast<std::uint32_t>(r)] += t[r];
+    }
+  };
+  for (std::uint32_t k = 1; k < n_; ++k) edge(seq_[k], lin_[k]);
+  for (std::uint32_t q = 0; q < loops_; ++q) edge(loop_[q], lin_[options_.max_nodes + q]);
+}
+
+// M: the diagonal blocks of H (all constraints) and the off-diagonal blocks of the
+// sequential constraints; block LDLᵀ over nodes 1..n-1 (index k ↔ node k).
+bool FrameGraph::factorise() {
+  // Diagonal blocks into diag_inv_ (as plain blocks first), upper blocks into upper_.
+  for (std::uint32_t k = 0; k < 9U * n_; ++k) {
+    diag_inv_[k] = 0.0;
+    upper_[k] = 0.0;
+  }
+  auto add_diag = [&](const Constraint& c, const Linear& l, bool with_upper) {
+    const double w[3] = {l.w * c.info.xy, l.w * c.info.xy, l.w * c.info.theta};
+    if (c.i != 0U) add_at_w_b(l.a, w, l.a, diag_inv_ + 9U * c.i);
+    if (c.j != 0U) add_at_w_b(l.b, w, l.b, diag_inv_ + 9U * c.j);
+    if (with_upper && c.i != 0U) add_at_w_b(l.a, w, l.b, upper_ + 9U * c.i);  // block (i, i+1)
+  };
+  for (std::uint32_t k = 1; k < n_; ++k) add_diag(seq_[k], lin_[k], true);
+  for (std::uint32_t q = 0; q < loops_; ++q) add_diag(loop_[q], lin_[options_.max_nodes + q], false);
+  // S_1 = D_1; S_k = D_k − U_(k−1)ᵀ S_(k−1)⁻¹ U_(k−1). diag_inv_ ends up holding S_k⁻¹.
+  double s[9], tmp[9], prod[9];
+  for (std::uint32_t k = 1; k < n_; ++k) {
+    for (int e = 0; e < 9; ++e) s[e] = diag_inv_[9U * k + static_cast<std::uint32_t>(e)];
+    if (k > 1U) {
+      mat_mul(diag_inv_ + 9U * (k - 1U), upper_ + 9U * (k - 1U), tmp);  // S⁻¹ U
+      mat_t_mul(upper_ + 9U * (k - 1U), tmp, prod);                     // Uᵀ S⁻¹ U
+      for (int e = 0; e < 9; ++e) s[e] -= prod[e];
+    }
+    if (!inverse3(s, diag_inv_ + 9U * k)) return false;
+  }
+  return true;
+}
+
+// z = M⁻¹ r: forward y_k = r_k − U_(k−1)ᵀ S_(k−1)⁻¹ y_(k−1), back z_k = S_k⁻¹ (y_k − U_k z_(k+1)).
+void FrameGraph::precondition(const double* r, double* out) const {
+  double* y = work_ + 15U * options_.max_nodes;
+  double t[3], u[3];
+  for (std::uint32_t k = 1; k < n_; ++k) {
+    for (int e = 0; e < 3; ++e) y[3U * k + static_cast<std::uint32_t>(e)] = r[3U * k + static_cast<std::uint32_t>(e)];
+    if (k > 1U) {
+      mat_vec(diag_inv_ + 9U * (k - 1U), y + 3U * (k - 1U), t);
+      mat_t_vec(upper_ + 9U * (k - 1U), t, u);
+      for (int e = 0; e < 3; ++e) y[3U * k + static_cast<std::uint32_t>(e)] -= u[e];
+    }
+  }
+  for (int e = 0; e < 3; ++e) out[e] = 0.0;
+  for (std::uint32_t k = n_ - 1U; k >= 1U; --k) {
+    for (int e = 0; e < 3; ++e) t[e] = y[3U * k + static_cast<std::uint32_t>(e)];
+    if (k + 1U < n_) {
+      mat_vec(upper_ + 9U * k, out + 3U * (k + 1U), u);
+      for (int e = 0; e < 3; ++e) t[e] -= u[e];
+    }
+    mat_vec(diag_inv_ + 9U * k, t, out + 3U * k);
+  }
+}
+
+void FrameGraph::optimise() {
+  if (!initialised_ || n_ < 2U) return;
+  ++stats_.solves;
+  const std::size_t m = 3U * static_cast<std::size_t>(options_.max_nodes);
+  double* x = work_;          // Δ
+  double* r = work_ + m;      // residual of H Δ = −b
+  double* z = work_ + 2U * m;
+  double* p = work_ + 3U * m;
+  double* hp = work_ + 4U * m;
+  // work_ + 15·max_nodes .. 18·max_nodes: the preconditioner's y (see precondition()).
+  const std::size_t dim = 3U * n_;
+  const double c2 = options_.robust_chi * options_.robust_chi;
+  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy).
+  auto total_chi2 = [&]() {
+    double s = 0.0;
+    for (std::uint32_t k = 1; k < n_; ++k) s += chi2(seq_[k]);
+    for (std::uint32_t q = 0; q < loops_; ++q) s += c2 * det::log(1.0 + chi2(loop_[q]) / c2);
+    return s;
+  };
+  for (std::uint32_t q = 0; q < loops_; ++q) loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / c2);
+  stats_.last_chi2_before = total_chi2();
+  for (std::uint32_t it = 0; it < options_.iterations; ++it) {
+    for (std::uint32_t k = 1; k < n_; ++k) linearise(seq_[k], lin_[k]);
+    for (std::uint32_t q = 0; q < loops_; ++q) {
+      Linear& l = lin_[options_.max_nodes + q];
+      linearise(loop_[q], l);
+      const double e2 = loop_[q].info.xy * (l.e[0] * l.e[0] + l.e[1] * l.e[1]) + loop_[q].info.theta * l.e[2] * l.e[2];
+      l.w = 1.0 / (1.0 + e2 / c2);
+      loop_w_[q] = l.w;
+    }
+    // b = Σ Jᵀ Ω e; r = −b (Δ = 0 to start).
+    for (std::size_t k = 0; k < dim; ++k) {
+      x[k] = 0.0;
+      r[k] = 0.0;
+    }
+    auto add_b = [&](const Constraint& c, const Linear& l) {
+      const double we[3] = {l.w * c.info.xy * l.e[0], l.w * c.info.xy * l.e[1], l.w * c.info.theta * l.e[2]};
+      double t[3];
+      if (c.i != 0U) {
+        mat_t_vec(l.a, we, t);
+        for (int e = 0; e < 3; ++e) r[3U * c.i + static_cast<std::uint32_t>(e)] -= t[e];
+      }
+      if (c.j != 0U) {
+        mat_t_vec(l.b, we, t);
+        for (int e = 0; e < 3; ++e) r[3U * c.j + static_cast<std::uint32_t>(e)] -= t[e];
+      }
+    };
+    for (std::uint32_t k = 1; k < n_; ++k) add_b(seq_[k], lin_[k]);
+    for (std::uint32_t q = 0; q < loops_; ++q) add_b(loop_[q], lin_[options_.max_nodes + q]);
+    if (!factorise()) return;
+    precondition(r, z);
+    for (std::size_t k = 0; k < dim; ++k) p[k] = z[k];
+    double rz = dot(r, z, dim);
+    const double r0 = dot(r, r, dim);
+    if (!(r0 > 1e-24)) break;
+    for (std::uint32_t cg = 0; cg < options_.cg_iterations; ++cg) {
+      multiply(p, hp);
+      for (int e = 0; e < 3; ++e) hp[e] = 0.0;
+      const double php = dot(p, hp, dim);
+      if (!(php > 0.0)) break;
+      const double alpha = rz / php;
+      for (std::size_t k = 3; k < dim; ++k) {
+        x[k] += alpha * p[k];
+        r[k] -= alpha * hp[k];
+      }
+      if (dot(r, r, dim) < 1e-20 * r0) break;
+      precondition(r, z);
+      const double rz_new = dot(r, z, dim);
+      const double beta = rz_new / rz;
+      rz = rz_new;
+      for (std::size_t k = 3; k < dim; ++k) p[k] = z[k] + beta * p[k];
+    }
+    double step = 0.0;
+    for (std::uint32_t k = 1; k < n_; ++k) {
+      pose_[k].x_m += x[3U * k];
+      pose_[k].y_m += x[3U * k + 1U];
+      pose_[k].heading_rad = normalize_angle_rad(pose_[k].heading_rad + x[3U * k + 2U]);
+      step += x[3U * k] * x[3U * k] + x[3U * k + 1U] * x[3U * k + 1U] + x[3U * k + 2U] * x[3U * k + 2U];
+    }
+    if (step < 1e-14) break;
+  }
+  std::uint32_t down = 0U;
+  for (std::uint32_t q = 0; q < loops_; ++q) {
+    loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / c2);
+    if (loop_w_[q] < 0.5) ++down;
+  }
+  stats_.last_chi2_after = total_chi2();
+  stats_.last_downweighted = down;
+}
+
+}  // namespace sdpslam

@@ -1,0 +1,140 @@
+// FrameGraph (core/frame_graph.h): the loop-closure pose graph over submap frames.
+// A drifting chain around a square loop is pulled back onto the true frames by one loop
+// constraint; a wrong loop constraint among good ones is down-weighted by the kernel;
+// capacities refuse and count; results are bit-identical across runs.
+#include <cmath>
+#include <vector>
+
+#include "CppUTest/TestHarness.h"
+#include "sdpslam/core/frame_graph.h"
+
+using namespace sdpslam;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// True frames: 16 submaps 2 m apart around a 8 m × 8 m square (a turn of 90° every 4).
+std::vector<Pose2> square_truth() {
+  std::vector<Pose2> v;
+  Pose2 p;
+  for (int k = 0; k < 16; ++k) {
+    v.push_back(p);
+    const Pose2 step = (k % 4 == 3) ? Pose2{2.0, 0.0, kPi / 2.0} : Pose2{2.0, 0.0, 0.0};
+    p = p.compose(step);
+  }
+  return v;
+}
+
+double position_error(const Pose2& a, const Pose2& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+
+struct Rig {
+  alignas(std::max_align_t) unsigned char buffer[1 << 20];
+  Arena arena{buffer, sizeof buffer};
+  FrameGraph graph;
+  std::vector<Pose2> truth = square_truth();
+  // Sequential measurements with a heading bias of 0.02 rad per step: the chain drifts.
+  void build_drifting_chain() {
+    graph.clear();
+    Pose2 est = truth[0];
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      Pose2 z;
+      if (k > 0) {
+        z = between(truth[k - 1], truth[k]);
+        z.heading_rad += 0.02;
+        est = est.compose(z);
+      }
+      CHECK_TRUE(graph.add_node(k == 0 ? truth[0] : est, z, FrameInfo::from_sigma(0.1, 0.02)));
+    }
+  }
+};
+
+}  // namespace
+
+TEST_GROUP(FrameGraph) {
+  Rig* rig = nullptr;
+  void setup() override {
+    rig = new Rig();
+    FrameGraphOptions o;
+    o.max_nodes = 32U;
+    o.max_loops = 8U;
+    CHECK_TRUE(rig->graph.init(o, rig->arena));
+  }
+  void teardown() override { delete rig; }
+};
+
+TEST(FrameGraph, a_single_loop_constraint_pulls_a_drifting_square_back_into_shape) {
+  rig->build_drifting_chain();
+  const std::vector<Pose2>& t = rig->truth;
+  const double before = position_error(rig->graph.frame(15), t[15]);
+  CHECK_TRUE(before > 1.0);  // the chain alone ends metres off
+  // Frame 15 seen from frame 0 (the robot is back near the start): exact.
+  CHECK_TRUE(rig->graph.add_loop(0, 15, between(t[0], t[15]), FrameInfo::from_sigma(0.05, 0.01)));
+  rig->graph.optimise();
+  double worst = 0.0;
+  for (std::uint32_t k = 0; k < 16U; ++k) worst = std::fmax(worst, position_error(rig->graph.frame(k), t[k]));
+  // The bias is spread over 15 steps: what remains is the bias's curvature, centimetres.
+  CHECK_TRUE(worst < 0.25);
+  CHECK_TRUE(position_error(rig->graph.frame(15), t[15]) < 0.05);
+  CHECK_TRUE(rig->graph.stats().last_chi2_after < rig->graph.stats().last_chi2_before);
+  DOUBLES_EQUAL(0.0, position_error(rig->graph.frame(0), t[0]), 0.0);  // the gauge stays
+}
+
+TEST(FrameGraph, a_wrong_loop_constraint_among_good_ones_is_down_weighted) {
+  rig->build_drifting_chain();
+  const std::vector<Pose2>& t = rig->truth;
+  const FrameInfo info = FrameInfo::from_sigma(0.05, 0.01);
+  CHECK_TRUE(rig->graph.add_loop(0, 15, between(t[0], t[15]), info));
+  CHECK_TRUE(rig->graph.add_loop(1, 14, between(t[1], t[14]), info));
+  CHECK_TRUE(rig->graph.add_loop(0, 14, between(t[0], t[14]), info));
+  // A false match 3 m off.
+  Pose2 wrong = between(t[4], t[12]);
+  wrong.x_m += 3.0;
+  CHECK_TRUE(rig->graph.add_loop(4, 12, wrong, info));
+  rig->graph.optimise();
+  CHECK_TRUE(rig->graph.loop_weight(3) < 0.1);
+  CHECK_TRUE(rig->graph.loop_weight(0) > 0.5);
+  CHECK_TRUE(position_error(rig->graph.frame(15), t[15]) < 0.3);
+}
+
+TEST(FrameGraph, capacities_refuse_and_count_and_bad_indices_are_refused) {
+  rig->graph.clear();
+  for (std::uint32_t k = 0; k < 32U; ++k) CHECK_TRUE(rig->graph.add_node(Pose2{}, Pose2{}, FrameInfo{}));
+  CHECK_FALSE(rig->graph.add_node(Pose2{}, Pose2{}, FrameInfo{}));
+  LONGS_EQUAL(1, rig->graph.stats().refused_nodes);
+  CHECK_FALSE(rig->graph.add_loop(3, 3, Pose2{}, FrameInfo{}));
+  CHECK_FALSE(rig->graph.add_loop(0, 32, Pose2{}, FrameInfo{}));
+  for (std::uint32_t k = 0; k < 8U; ++k) CHECK_TRUE(rig->graph.add_loop(0, k + 1U, Pose2{}, FrameInfo{}));
+  CHECK_FALSE(rig->graph.add_loop(0, 20, Pose2{}, FrameInfo{}));
+  LONGS_EQUAL(3, rig->graph.stats().refused_loops);
+  rig->graph.optimise();  // consistent already: nothing moves
+  for (std::uint32_t k = 0; k < 32U; ++k) DOUBLES_EQUAL(0.0, rig->graph.frame(k).x_m, 1e-12);
+}
+
+TEST(FrameGraph, the_same_graph_gives_bit_identical_frames) {
+  const std::vector<Pose2>& t = rig->truth;
+  rig->build_drifting_chain();
+  rig->graph.add_loop(0, 15, between(t[0], t[15]), FrameInfo::from_sigma(0.05, 0.01));
+  rig->graph.optimise();
+  std::vector<Pose2> first;
+  for (std::uint32_t k = 0; k < 16U; ++k) first.push_back(rig->graph.frame(k));
+  rig->build_drifting_chain();
+  rig->graph.add_loop(0, 15, between(t[0], t[15]), FrameInfo::from_sigma(0.05, 0.01));
+  rig->graph.optimise();
+  for (std::uint32_t k = 0; k < 16U; ++k) {
+    CHECK_TRUE(first[k].x_m == rig->graph.frame(k).x_m);
+    CHECK_TRUE(first[k].y_m == rig->graph.frame(k).y_m);
+    CHECK_TRUE(first[k].heading_rad == rig->graph.frame(k).heading_rad);
+  }
+}
+
+TEST(FrameGraph, invalid_options_and_a_small_arena_are_refused) {
+  FrameGraphOptions o;
+  o.max_nodes = 1U;
+  FrameGraph g;
+  CHECK_FALSE(g.init(o, rig->arena));
+  LONGS_EQUAL(0, FrameGraph::required_bytes(o));
+  alignas(std::max_align_t) unsigned char tiny[256];
+  Arena small(tiny, sizeof tiny);
+  CHECK_FALSE(g.init(FrameGraphOptions{}, small));
+}
