@@ -73,6 +73,18 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.integer("map_observation_capacity", map_observation_capacity, 0U, 0xE0000000U);
   c.real("icp_correction_weight", icp_correction_weight, 0.0, 100.0);
   c.real("icp_correction_lever_m", icp_correction_lever_m, 0.0, 100.0);
+  c.integer("loop_points", loop_points, 16U, capacity::kMaxIcpPoints);
+  c.real("loop_icp_max_correspondence_m", loop_icp_max_correspondence_m, 0.01, 10.0);
+  c.real("loop_max_error_m", loop_max_error_m, 0.0, 10.0);
+  c.integer("loop_min_pairs", loop_min_pairs, 1U, capacity::kMaxIcpPoints);
+  c.real("loop_max_correction_m", loop_max_correction_m, 0.0, 1.0e3);
+  c.real("segment_sigma_xy_m", segment_sigma_xy_m, 1.0e-4, 100.0);
+  c.real("segment_sigma_theta_rad", segment_sigma_theta_rad, 1.0e-5, 10.0);
+  c.real("loop_sigma_xy_m", loop_sigma_xy_m, 1.0e-4, 100.0);
+  c.real("loop_sigma_theta_rad", loop_sigma_theta_rad, 1.0e-5, 10.0);
+  c.real("loop_robust_chi", loop_robust_chi, 1.0e-3, 1.0e3);
+  c.integer("max_loop_constraints", max_loop_constraints, 1U, capacity::kMaxLoopConstraints);
+  c.integer("graph_iterations", graph_iterations, 1U, 50U);
   if (c.ok && !icp.valid()) c.fail("icp: options out of range (see icp2d.h Icp2dOptions::valid)");
   return c.ok;
 }

@@ -11,10 +11,6 @@ namespace {
 
 constexpr std::size_t kSlack = 64U;
 
-template <typename T>
-std::size_t bytes_of(std::size_t n) {
-  return sizeof(T) * n + alignof(T) + kSlack;
-}
 
 std::uint32_t fine_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
   return static_cast<std::uint32_t>(s.skeleton_max_side_m / b.map_resolution_m) + 2U;
@@ -23,6 +19,16 @@ std::uint32_t coarse_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
   return fine_side_cells(b, s) / s.skeleton_downsample + 2U;
 }
 std::uint32_t ring_capacity_for(const SdpOptions& s) { return (s.max_levels + 2U) * (s.max_segment_scans + 2U); }
+
+// The loop-closure graph holds every permanent submap still kept and every live level.
+FrameGraphOptions frame_graph_options(const SdpOptions& s) {
+  FrameGraphOptions o;
+  o.max_nodes = s.max_permanent_submaps + s.max_levels;
+  o.max_loops = s.max_loop_constraints;
+  o.iterations = s.graph_iterations;
+  o.robust_chi = s.loop_robust_chi;
+  return o;
+}
 
 SegmentGraphOptions graph_options(const SdpOptions& s, std::uint32_t n) {
   SegmentGraphOptions g;
@@ -112,15 +118,20 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   const std::size_t L = s.max_levels;
   const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
   const std::size_t cs = coarse_side_cells(b, s);
-  std::size_t total = fb + gb + bytes_of<DpSlamFilter>(1U) + bytes_of<Icp2d>(1U) + bytes_of<Segmenter>(1U);
+  std::size_t total = fb + gb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
   total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
-  total += bytes_of<Submap>(L * n) + bytes_of<Point2>(L * n * s.skeleton_points) + bytes_of<Level>(L);
-  total += bytes_of<Permanent>(s.max_permanent_submaps) + bytes_of<Point2>(s.max_permanent_submaps * std::size_t{s.skeleton_points});
-  total += 2U * bytes_of<std::uint16_t>(t * L) + bytes_of<double>(t) + bytes_of<std::uint8_t>(t) +
-           bytes_of<std::uint32_t>(t);
-  total += bytes_of<std::uint32_t>(L) + 2U * bytes_of<Pose2>(L) + bytes_of<Pose2>(n);
-  total += bytes_of<StampedPose>(ring_capacity_for(s)) + bytes_of<IcpMemo>(kIcpMemoSlots) + bytes_of<NodeId>(n);
-  total += bytes_of<CellObservation>(fine) + bytes_of<std::uint8_t>(fine) + bytes_of<CellState>(cs * cs);
+  total += Arena::bytes_for<Submap>(L * n) + Arena::bytes_for<Point2>(L * n * s.skeleton_points) + Arena::bytes_for<Level>(L);
+  total += Arena::bytes_for<Permanent>(s.max_permanent_submaps) + Arena::bytes_for<Point2>(s.max_permanent_submaps * std::size_t{s.skeleton_points});
+  total += 2U * Arena::bytes_for<std::uint16_t>(t * L) + Arena::bytes_for<double>(t) + Arena::bytes_for<std::uint8_t>(t) +
+           Arena::bytes_for<std::uint32_t>(t);
+  total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
+  total += Arena::bytes_for<StampedPose>(ring_capacity_for(s)) + Arena::bytes_for<IcpMemo>(kIcpMemoSlots) + Arena::bytes_for<NodeId>(n);
+  if (s.loop_closure) {
+    total += Arena::bytes_for<LoopRecord>(s.max_loop_constraints) + FrameGraph::required_bytes(frame_graph_options(s));
+    total += Arena::bytes_for<CellPoint>((L * n + s.max_permanent_submaps) * std::size_t{s.loop_points}) +
+             2U * Arena::bytes_for<Point2>(s.loop_points);
+  }
+  total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
   return total + kSlack;
 }
 
@@ -188,6 +199,23 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   ring_capacity_ = ring_capacity_for(s);
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
   memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
+  loop_count_ = 0U;
+  if (s.loop_closure) {
+    loops_ = arena.allocate_array<LoopRecord>(s.max_loop_constraints);
+    live_obst_ = arena.allocate_array<CellPoint>(std::size_t{L} * n_bottom_ * s.loop_points);
+    perm_obst_ = arena.allocate_array<CellPoint>(std::size_t{s.max_permanent_submaps} * s.loop_points);
+    obst_a_ = arena.allocate_array<Point2>(s.loop_points);
+    obst_b_ = arena.allocate_array<Point2>(s.loop_points);
+    if (b.map_width_m / b.map_resolution_m > 32767.0 || b.map_height_m / b.map_resolution_m > 32767.0) {
+      std::snprintf(why_, sizeof why_, "sdp.loop_closure: the map grid is wider than 32767 cells");
+      return false;
+    }
+    if (loops_ == nullptr || live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr ||
+        obst_b_ == nullptr || !frame_graph_.init(frame_graph_options(s), arena)) {
+      std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");
+      return false;
+    }
+  }
   release_queue_ = arena.allocate_array<NodeId>(n_bottom_);
   const std::uint32_t fs = fine_side_cells(b, s);
   fine_cells_ = static_cast<std::size_t>(fs) * fs;
@@ -419,15 +447,16 @@ void SdpSlam::make_oldest_permanent() {
   }
   rank_particles();
   const std::uint32_t chosen = choice(order_[0], level);
+  const bool had_anchor = graph_.has_anchor();
+  const Pose2 previous_frame = graph_.anchor_frame();
   const PgsPermanentResult r = graph_.make_oldest_permanent(chosen);
   if (r.status != PgsStatus::kOk) return;
   ++stats_.levels_made_permanent;
   const Submap& sm = submap(level, chosen);
-  // Its poses, in the global frame.
+  // Its poses, in its own frame, and that frame in the global frame.
   if (permanent_sink_ != nullptr) {
-    for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) {
-      permanent_sink_->on_committed(s, r.frame_in_global.compose(p));
-    });
+    permanent_sink_->on_frame(level, r.frame_in_global);
+    for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) { permanent_sink_->on_pose(level, s, p); });
   }
   // Its skeleton joins the permanent ring (the oldest is forgotten when full).
   if (perm_count_ == options_.max_permanent_submaps) {
@@ -438,9 +467,18 @@ void SdpSlam::make_oldest_permanent() {
   const std::uint32_t pi = (perm_head_ + perm_count_) % options_.max_permanent_submaps;
   Permanent& pm = perm_[pi];
   pm.frame_in_global = r.frame_in_global;
+  pm.from_previous = had_anchor ? between(previous_frame, r.frame_in_global) : Pose2{};
   for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
   pm.level = level;
   pm.point_count = sm.point_count;
+  pm.node = static_cast<std::uint16_t>(chosen);
+  pm.obstacle_count = 0U;
+  if (options_.loop_closure) {
+    const CellPoint* from = live_obstacles(level, chosen);
+    CellPoint* to = perm_obstacles(pi);
+    for (std::uint32_t i = 0; i < sm.obstacle_count; ++i) to[i] = from[i];
+    pm.obstacle_count = sm.obstacle_count;
+  }
   const Point2* src = live_points(level, chosen);
   Point2* dst = perm_points(pi);
   for (std::uint32_t i = 0; i < sm.point_count; ++i) dst[i] = src[i];
@@ -535,6 +573,7 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
   Submap& sm = submap(level, node);
   sm.skeleton_done = true;
   sm.point_count = 0U;
+  sm.obstacle_count = 0U;
   box_init(sm.box);
   CellRect r = sm.path_rect;
   const std::uint32_t d = options_.skeleton_downsample;
@@ -584,6 +623,7 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
   so.min_clearance_m = options_.skeleton_min_clearance_m;
   so.max_points = options_.skeleton_points;
   Point2* out = live_points(level, node);
+  if (options_.loop_closure) extract_obstacles(sm, live_obstacles(level, node), r, cw, ch);
   const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
   ++stats_.skeletons;
   if (res.status == SkeletonResult::Status::kOk) {
@@ -781,6 +821,40 @@ void SdpSlam::evaluate(std::uint32_t p) {
         ++stats_.icp_matches;
         e = r.mean_nn_error_m;
         w = static_cast<double>(r.matched_pairs);
+        if (options_.loop_closure) {
+          // Refine on obstacle points, starting from the skeleton match.
+          const CellPoint* to = nullptr;
+          std::uint32_t tn = 0U;
+          LoopRecord lr;
+          if (c.older >= 0) {
+            to = live_obstacles(older_level, chain_[c.older]);
+            tn = submap(older_level, chain_[c.older]).obstacle_count;
+            lr.older_level = older_level;
+          } else {
+            const Permanent& pm = perm_[-c.older - 1];
+            to = perm_obstacles(static_cast<std::uint32_t>(-c.older - 1));
+            tn = pm.obstacle_count;
+            lr.older_level = pm.level;
+          }
+          lr.newer_level = first + c.newer;
+          const std::uint32_t sn_count = sn.obstacle_count;
+          if (tn >= options_.loop_min_pairs && sn_count >= options_.loop_min_pairs) {
+            unpack(to, tn, obst_a_);
+            unpack(live_obstacles(first + c.newer, chain_[c.newer]), sn_count, obst_b_);
+            Icp2dOptions fine = options_.icp;
+            fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
+            fine.min_pairs = options_.loop_min_pairs;
+            const Icp2dResult f = icp_->match(obst_a_, tn, obst_b_, sn_count, r.transform, fine);
+            ++stats_.loop_refinements;
+            const Pose2 moved = between(guess, f.transform);
+            if (f.usable() && f.mean_nn_error_m <= options_.loop_max_error_m && f.matched_pairs >= options_.loop_min_pairs &&
+                det::sqrt(moved.x_m * moved.x_m + moved.y_m * moved.y_m) <= options_.loop_max_correction_m) {
+              lr.z = f.transform;
+              lr.error_m = f.mean_nn_error_m;
+              record_loop(lr);
+            }
+          }
+        }
         if (options_.icp_correction_weight > 0.0) {
           const Pose2 d = between(guess, r.transform);
           e += options_.icp_correction_weight *
@@ -849,9 +923,172 @@ void SdpSlam::update_best() {
   }
   for (std::uint32_t i = 0; i < count; ++i) chain_[i] = choice(best_top_, first + i);
   if (graph_.compose_chain(chain_, count, frames_) != PgsStatus::kOk) return;
+  if (options_.loop_closure) adjust_frames();
   const Submap& last = submap(first + count - 1U, chain_[count - 1U]);
   // The current segment starts where the last chosen submap ends (Fig. 3 (l)).
   current_frame_ = frames_[count - 1U].compose(last.final_pose.compose(segment_start_pose_.inverse()));
+}
+
+// ---- loop closure (beyond the paper; see the header) ------------------------------------
+
+// Occupied coarse cells with a free 4-neighbour (wall surfaces seen from free space),
+// thinned by a fixed stride to at most loop_points, stored as the fine cell at the
+// coarse cell's centre. Reads coarse_ as extract_skeleton() just filled it.
+void SdpSlam::extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch) {
+  auto state = [&](std::uint32_t x, std::uint32_t y) { return coarse_[static_cast<std::size_t>(y) * cw + x]; };
+  auto surface = [&](std::uint32_t x, std::uint32_t y) {
+    if (state(x, y) != CellState::kOccupied) return false;
+    return (x > 0U && state(x - 1U, y) == CellState::kFree) || (x + 1U < cw && state(x + 1U, y) == CellState::kFree) ||
+           (y > 0U && state(x, y - 1U) == CellState::kFree) || (y + 1U < ch && state(x, y + 1U) == CellState::kFree);
+  };
+  std::uint32_t total = 0U;
+  for (std::uint32_t y = 0; y < ch; ++y) {
+    for (std::uint32_t x = 0; x < cw; ++x) total += surface(x, y) ? 1U : 0U;
+  }
+  const std::uint32_t k = options_.loop_points;
+  const std::uint32_t stride = total > k ? (total + k - 1U) / k : 1U;
+  const std::uint32_t d = options_.skeleton_downsample;
+  std::uint32_t seen = 0U;
+  std::uint32_t n = 0U;
+  for (std::uint32_t y = 0; y < ch && n < k; ++y) {
+    for (std::uint32_t x = 0; x < cw && n < k; ++x) {
+      if (!surface(x, y)) continue;
+      if (seen++ % stride != 0U) continue;
+      // Centre of the coarse cell in half fine cells from the map's origin.
+      const std::int64_t ix = 2 * (static_cast<std::int64_t>(r.ix0) + static_cast<std::int64_t>(x * d)) + d;
+      const std::int64_t iy = 2 * (static_cast<std::int64_t>(r.iy0) + static_cast<std::int64_t>(y * d)) + d;
+      if (ix < 0 || iy < 0 || ix > 65535 || iy > 65535) continue;
+      out[n].ix = static_cast<std::uint16_t>(ix);
+      out[n].iy = static_cast<std::uint16_t>(iy);
+      ++n;
+    }
+  }
+  sm.obstacle_count = n;
+}
+
+std::uint32_t SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
+  const DpMap& map = filter_->map();
+  const double half = 0.5 * map.resolution_m();
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    out[i].x_m = ox + static_cast<double>(in[i].ix) * half;
+    out[i].y_m = oy + static_cast<double>(in[i].iy) * half;
+  }
+  return n;
+}
+
+bool SdpSlam::permanent_slot(std::uint32_t level, std::uint32_t* pi) const {
+  if (perm_count_ == 0U) return false;
+  const std::uint32_t oldest = perm_[perm_head_].level;
+  if (level < oldest || level - oldest >= perm_count_) return false;
+  const std::uint32_t k = (perm_head_ + (level - oldest)) % options_.max_permanent_submaps;
+  if (perm_[k].level != level) return false;  // levels are made permanent in order
+  *pi = k;
+  return true;
+}
+
+// Graph order: the permanent submaps held, oldest first, then the live levels. All
+// submaps of a level share the level's frame (the bottom particles restarted at one
+// pose in the map's grid frame), so a constraint between two levels' frames measured
+// with some of their submaps holds for the chosen ones too.
+bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
+  std::uint32_t pi = 0U;
+  if (permanent_slot(level, &pi)) {
+    *index = level - perm_[perm_head_].level;
+    return true;
+  }
+  const std::uint32_t first = graph_.first_live_level();
+  if (level < first || level >= first + graph_.live_level_count()) return false;
+  *index = perm_count_ + (level - first);
+  return true;
+}
+
+// A record can never join the graph again once one of its levels was forgotten.
+bool SdpSlam::loop_record_dead(const LoopRecord& r) const {
+  std::uint32_t index = 0U;
+  return !graph_index(r.older_level, &index) || !graph_index(r.newer_level, &index);
+}
+
+// One record per pair of levels (the lowest residual wins). When the store is full a
+// dead record makes room, else the worst record if the new one is better.
+void SdpSlam::record_loop(const LoopRecord& r) {
+  std::uint32_t worst = loop_count_;
+  std::uint32_t dead = loop_count_;
+  for (std::uint32_t k = 0; k < loop_count_; ++k) {
+    LoopRecord& q = loops_[k];
+    if (q.older_level == r.older_level && q.newer_level == r.newer_level) {
+      if (r.error_m < q.error_m) q = r;
+      return;
+    }
+    if (dead == loop_count_ && loop_count_ == options_.max_loop_constraints && loop_record_dead(q)) dead = k;
+    if (worst == loop_count_ || q.error_m > loops_[worst].error_m) worst = k;
+  }
+  ++stats_.loop_records_added;
+  if (loop_count_ < options_.max_loop_constraints) {
+    loops_[loop_count_++] = r;
+  } else if (dead < loop_count_) {
+    loops_[dead] = r;
+  } else if (worst < loop_count_ && r.error_m < loops_[worst].error_m) {
+    loops_[worst] = r;
+    ++stats_.loop_records_dropped;
+  } else {
+    ++stats_.loop_records_dropped;
+  }
+  stats_.loop_records = loop_count_;
+}
+
+// The best combination's frames as a pose graph (frame_graph.h): permanent submaps held
+// (oldest fixed), then the chosen live submaps (frames_ on entry: the composed chain),
+// chain constraints T between consecutive ones, loop constraints between any two.
+void SdpSlam::adjust_frames() {
+  const std::uint32_t first = graph_.first_live_level();
+  const std::uint32_t count = graph_.live_level_count();
+  FrameGraph& g = frame_graph_;
+  g.clear();
+  const FrameInfo seg = FrameInfo::from_sigma(options_.segment_sigma_xy_m, options_.segment_sigma_theta_rad);
+  const FrameInfo loop = FrameInfo::from_sigma(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad);
+  bool ok = true;
+  for (std::uint32_t k = 0; k < perm_count_; ++k) {
+    const Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
+    ok = ok && g.add_node(pm.frame_in_global, pm.from_previous, seg);
+  }
+  for (std::uint32_t i = 0; i < count && ok; ++i) {
+    Pose2 t;
+    if (i > 0U) {
+      ok = graph_.transform_between(first + i - 1U, chain_[i - 1U], chain_[i], t) == PgsStatus::kOk;
+    } else if (perm_count_ > 0U) {
+      t = between(graph_.anchor_frame(), frames_[0]);
+    }
+    ok = ok && g.add_node(frames_[i], t, seg);
+  }
+  if (!ok) {
+    ++stats_.frame_graph_refused;
+    return;
+  }
+  std::uint32_t used = 0U;
+  for (std::uint32_t k = 0; k < loop_count_; ++k) {
+    const LoopRecord& r = loops_[k];
+    std::uint32_t a = 0U, b = 0U;
+    if (!graph_index(r.older_level, &a) || !graph_index(r.newer_level, &b)) continue;
+    if (g.add_loop(a, b, r.z, loop)) {
+      ++used;
+    } else {
+      ++stats_.frame_graph_refused;
+    }
+  }
+  stats_.loop_constraints_used = used;
+  if (used == 0U) return;  // the chain alone is already consistent
+  g.optimise();
+  ++stats_.frame_adjustments;
+  stats_.loop_downweighted = g.stats().last_downweighted;
+  for (std::uint32_t k = 0; k < perm_count_; ++k) {
+    Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
+    pm.frame_in_global = g.frame(k);
+    if (permanent_sink_ != nullptr) permanent_sink_->on_frame(pm.level, pm.frame_in_global);
+  }
+  if (perm_count_ > 0U) graph_.set_anchor_frame(g.frame(perm_count_ - 1U));
+  for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(perm_count_ + i);
 }
 
 }  // namespace sdpslam

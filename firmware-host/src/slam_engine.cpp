@@ -111,7 +111,8 @@ class SdpEngine final : public SlamEngine {
       *error = std::string("SDP-SLAM init failed: ") + slam_->why();
       return false;
     }
-    permanent_.poses.reserve(c.max_trajectory_scans);
+    // A level holds at least min_segment_scans processed scans.
+    permanent_.reserve(c.max_trajectory_scans, c.max_trajectory_scans / c.sdp.min_segment_scans + 1U);
     slam_->set_permanent_sink(&permanent_);
     scans_.reserve(c.max_trajectory_scans);
     return true;
@@ -130,7 +131,7 @@ class SdpEngine final : public SlamEngine {
   }
 
   std::vector<io::StampedPose> trajectory() const override {
-    return slam::assemble_trajectory(scans_, slam::sdp_best_path(*slam_, permanent_.poses), &path_gaps_);
+    return slam::assemble_trajectory(scans_, slam::sdp_best_path(*slam_, permanent_), &path_gaps_);
   }
 
   std::uint32_t map_image(io::OccupancyImage* image) const override {
@@ -144,7 +145,7 @@ class SdpEngine final : public SlamEngine {
     auto u = [](std::uint64_t v) { return std::to_string(v); };
     std::string js = "\"particles\": " + u(slam_->bottom().particle_count()) + ", \"top_particles\": " +
                      u(slam_->options().top_particles) + ", \"processed\": " + u(slam_->bottom().stats().processed) +
-                     ", \"committed_poses_dropped\": " + u(permanent_.dropped) + ", \"unrecorded_scans\": " +
+                     ", \"committed_poses_dropped\": " + u(permanent_.dropped()) + ", \"unrecorded_scans\": " +
                      u(unrecorded_) + ",\n";
     // The offline runner's stats.json members; trajectory gaps and known cells as of the
     // last trajectory() / map_image().
@@ -160,7 +161,7 @@ class SdpEngine final : public SlamEngine {
   std::unique_ptr<unsigned char[]> buffer_;
   std::unique_ptr<Arena> arena_;
   std::unique_ptr<SdpSlam> slam_;
-  PathSink permanent_;  // poses of the segments made permanent, global frame
+  slam::SdpPermanentPath permanent_;  // the segments made permanent
   std::vector<slam::ScanRecord> scans_;
   std::uint64_t unrecorded_ = 0U;
   mutable std::uint64_t path_gaps_ = 0U;

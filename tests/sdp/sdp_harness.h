@@ -61,14 +61,28 @@ struct ScanSet {
   }
 };
 
-class CollectPoses final : public PoseSink {
+// The permanent path: local poses by level, and each level's latest frame.
+class CollectPoses final : public SdpPathSink {
  public:
-  void on_committed(std::int64_t s, const Pose2& p) override {
+  void on_pose(std::uint32_t level, std::int64_t s, const Pose2& p) override {
+    levels.push_back(level);
     stamps.push_back(s);
-    poses.push_back(p);
+    local.push_back(p);
   }
+  void on_frame(std::uint32_t level, const Pose2& f) override {
+    if (level >= frames.size()) frames.resize(level + 1U);
+    frames[level] = f;
+  }
+  // Poses in the global frame.
+  std::vector<Pose2> poses() const {
+    std::vector<Pose2> out;
+    for (std::size_t k = 0; k < local.size(); ++k) out.push_back(frames.at(levels[k]).compose(local[k]));
+    return out;
+  }
+  std::vector<std::uint32_t> levels;
   std::vector<std::int64_t> stamps;
-  std::vector<Pose2> poses;
+  std::vector<Pose2> local;
+  std::vector<Pose2> frames;
 };
 
 }  // namespace sdpslam::test

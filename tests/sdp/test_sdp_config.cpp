@@ -28,6 +28,19 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   LONGS_EQUAL(d.skeleton_points, o.skeleton_points);
   LONGS_EQUAL(static_cast<int>(d.accumulation), static_cast<int>(o.accumulation));
   LONGS_EQUAL(static_cast<int>(d.segmentation), static_cast<int>(o.segmentation));
+  CHECK_EQUAL(d.loop_closure, o.loop_closure);
+  LONGS_EQUAL(d.loop_points, o.loop_points);
+  DOUBLES_EQUAL(d.loop_icp_max_correspondence_m, o.loop_icp_max_correspondence_m, 0.0);
+  DOUBLES_EQUAL(d.loop_max_error_m, o.loop_max_error_m, 0.0);
+  LONGS_EQUAL(d.loop_min_pairs, o.loop_min_pairs);
+  DOUBLES_EQUAL(d.loop_max_correction_m, o.loop_max_correction_m, 0.0);
+  DOUBLES_EQUAL(d.segment_sigma_xy_m, o.segment_sigma_xy_m, 0.0);
+  DOUBLES_EQUAL(d.segment_sigma_theta_rad, o.segment_sigma_theta_rad, 0.0);
+  DOUBLES_EQUAL(d.loop_sigma_xy_m, o.loop_sigma_xy_m, 0.0);
+  DOUBLES_EQUAL(d.loop_sigma_theta_rad, o.loop_sigma_theta_rad, 0.0);
+  DOUBLES_EQUAL(d.loop_robust_chi, o.loop_robust_chi, 0.0);
+  LONGS_EQUAL(d.max_loop_constraints, o.max_loop_constraints);
+  LONGS_EQUAL(d.graph_iterations, o.graph_iterations);
   // ... and the bottom-level loader skips the [sdp] section.
   slam::SlamConfig c;
   CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
@@ -49,6 +62,33 @@ TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line
   std::ofstream(path) << "[sdp]\ntopology = global\n";
   CHECK_FALSE(slam::load_sdp_ini(path, &o, &error));
   CHECK_TRUE_TEXT(error.find("topology") != std::string::npos, error.c_str());
+}
+
+TEST(SdpConfig, shipped_best_configuration_turns_on_scan_matching_and_loop_closure) {
+  const std::string best = std::string(SDPSLAM_DEFAULT_INI).substr(0, std::string(SDPSLAM_DEFAULT_INI).rfind('/')) + "/best.ini";
+  SdpOptions o;
+  std::string error;
+  CHECK_TRUE_TEXT(slam::load_sdp_ini(best, &o, &error), error.c_str());
+  CHECK_TRUE(o.loop_closure);
+  slam::SlamConfig c;
+  CHECK_TRUE_TEXT(slam::load_config_ini(best, &c, &error), error.c_str());
+  CHECK(c.filter.proposal == DpSlamOptions::Proposal::kScanMatch);
+  LONGS_EQUAL(8, c.filter.match.beam_stride);
+}
+
+TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
+  SdpOptions o;
+  std::string why;
+  CHECK(slam::apply_sdp_key(&o, "loop_closure", "true", &why) == slam::SdpKeyResult::kApplied);
+  CHECK_TRUE(o.loop_closure);
+  CHECK(slam::apply_sdp_key(&o, "loop_closure", "yes", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_max_correction_m", "2.5", &why) == slam::SdpKeyResult::kApplied);
+  DOUBLES_EQUAL(2.5, o.loop_max_correction_m, 0.0);
+  CHECK(slam::apply_sdp_key(&o, "loop_points", "8", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK_TRUE_TEXT(why.find("loop_points") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "loop_sigma_xy_m", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "graph_iterations", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "max_loop_constraints", "2000000", &why) == slam::SdpKeyResult::kInvalid);
 }
 
 TEST(SdpConfig, enumerated_keys_take_their_names) {

@@ -8,10 +8,12 @@
 using namespace sdpslam;
 
 namespace {
-class CountingSink final : public PoseSink {
+class CountingSink final : public SdpPathSink {
  public:
-  void on_committed(std::int64_t, const Pose2&) override { ++count; }
+  void on_pose(std::uint32_t, std::int64_t, const Pose2&) override { ++count; }
+  void on_frame(std::uint32_t, const Pose2&) override { ++frames; }
   std::uint64_t count = 0;
+  std::uint64_t frames = 0;
 };
 class CountingListener final : public TopLevelListener {
  public:
@@ -40,11 +42,13 @@ TEST(SdpNoHeap, init_builds_everything_in_the_arena) {
   }
 }
 
-TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) {
+namespace {
+// Runs three loops with the allocation counter watching everything after init.
+void run_without_heap(const SdpOptions& options) {
   CHECK_TRUE(sdpslam::test::allocation_counting_active());
   const test::ScanSet set(3);
   test::SdpRig rig;
-  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 9));
+  CHECK_TRUE(rig.init(test::sim_options(5), options, 9));
   CountingSink sink;
   CountingListener listener;
   rig.slam->set_permanent_sink(&sink);
@@ -65,4 +69,19 @@ TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) {
   CHECK(rig.slam->stats().levels_made_permanent > 0U);
   CHECK(rig.slam->stats().evaluations > 0U);
   CHECK(sink.count > 0U);
+  if (options.loop_closure) {
+    CHECK(rig.slam->stats().loop_records_added > 0U);
+    CHECK(rig.slam->stats().frame_adjustments > 0U);
+    CHECK(sink.frames > rig.slam->stats().levels_made_permanent);  // frames moved
+  }
+}
+}  // namespace
+
+TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) { run_without_heap(test::small_sdp_options()); }
+
+// Loop closure: obstacle points, loop records, the frame graph's solves.
+TEST(SdpNoHeap, loop_closure_allocates_nothing_after_init) {
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  run_without_heap(s);
 }

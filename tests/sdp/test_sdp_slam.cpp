@@ -24,7 +24,7 @@ Trace run_sdp(test::SdpRig& rig, const test::ScanSet& set, test::CollectPoses* s
   rig.slam->finish();
   Trace t;
   t.stamps = sink->stamps;
-  t.poses = sink->poses;
+  t.poses = sink->poses();
   rig.slam->for_each_best_pose([&](std::int64_t s, const Pose2& p) {
     t.stamps.push_back(s);
     t.poses.push_back(p);
@@ -128,6 +128,61 @@ TEST(SdpSlam, the_trajectory_follows_the_ground_truth) {
   char msg[128];
   std::snprintf(msg, sizeof msg, "SDP mean position error %.3f m, odometry %.3f m", mean, odo);
   CHECK_TEXT(mean < 0.5 * odo, msg);
+}
+
+namespace {
+double mean_error_to_truth(const Trace& t, const test::ScanSet& set) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < t.stamps.size(); ++k) {
+    const std::size_t i = static_cast<std::size_t>(t.stamps[k] / 100000);
+    const Pose2 truth = between(set.run.truth[0], set.run.truth[i]);
+    sum += std::hypot(t.poses[k].x_m - truth.x_m, t.poses[k].y_m - truth.y_m);
+  }
+  return sum / static_cast<double>(t.stamps.size());
+}
+}  // namespace
+
+// Beyond the paper: loop constraints found, the best combination's frames adjusted (the
+// permanent ones too: their sink hears of the new frames), still on the truth, and
+// reproducible bit for bit.
+TEST(SdpSlam, loop_closure_adjusts_the_frames_and_the_permanent_path_follows) {
+  const test::ScanSet set(3);
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  test::SdpRig a;
+  CHECK_TRUE(a.init(test::sim_options(5), s, 21));
+  test::CollectPoses sa;
+  const Trace ta = run_sdp(a, set, &sa);
+  const SdpStats& st = a.slam->stats();
+  CHECK(st.loop_refinements > 0U);
+  CHECK(st.loop_records_added > 0U);
+  CHECK(st.loop_constraints_used > 0U);
+  CHECK(st.frame_adjustments > 0U);
+  LONGS_EQUAL(0, st.frame_graph_refused);
+  CHECK(st.levels_made_permanent > 0U);
+  // Every permanent level got a frame, and some were moved after that.
+  CHECK(sa.frames.size() >= st.levels_made_permanent);
+  CHECK_TRUE(a.slam->graph().invariants_hold());
+  CHECK_TRUE(a.slam->bottom().tree().invariants_hold());
+  for (std::size_t i = 1; i < ta.stamps.size(); ++i) CHECK(ta.stamps[i] > ta.stamps[i - 1U]);
+  // The same run without loop closure, for the figure.
+  test::SdpRig b;
+  CHECK_TRUE(b.init(test::sim_options(5), test::small_sdp_options(), 21));
+  test::CollectPoses sb;
+  const Trace tb = run_sdp(b, set, &sb);
+  const double with_m = mean_error_to_truth(ta, set);
+  const double without_m = mean_error_to_truth(tb, set);
+  std::printf("\n  loop closure: mean position error %.3f m (without %.3f m), %llu constraints, %llu adjustments\n",
+              with_m, without_m, static_cast<unsigned long long>(st.loop_records_added),
+              static_cast<unsigned long long>(st.frame_adjustments));
+  CHECK(with_m < without_m);  // measured: 0.654 m against 0.870 m
+  // Deterministic with loop closure too.
+  test::SdpRig c;
+  CHECK_TRUE(c.init(test::sim_options(5), s, 21));
+  test::CollectPoses sc;
+  const Trace tc = run_sdp(c, set, &sc);
+  LONGS_EQUAL(ta.poses.size(), tc.poses.size());
+  CHECK_EQUAL(0, std::memcmp(ta.poses.data(), tc.poses.data(), ta.poses.size() * sizeof(Pose2)));
 }
 
 TEST(SdpSlam, same_seed_gives_bit_identical_trajectories) {

@@ -65,12 +65,6 @@ int sdp_handler(void* user, const char* section, const char* name, const char* v
 
 // ---- outputs ------------------------------------------------------------------------
 
-class CollectSink final : public PoseSink {
- public:
-  void on_committed(std::int64_t stamp_us, const Pose2& pose) override { poses.push_back({stamp_us, pose}); }
-  std::vector<io::StampedPose> poses;
-};
-
 struct Row {
   std::int64_t stamp_us;
   double mean_m;
@@ -204,6 +198,23 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "icp_min_pairs") ok = integer(&t.icp.min_pairs);
   else if (key == "icp_correction_weight") ok = real(&t.icp_correction_weight);
   else if (key == "icp_correction_lever_m") ok = real(&t.icp_correction_lever_m);
+  else if (key == "loop_closure") {
+    if (v == "true") t.loop_closure = true;
+    else if (v == "false") t.loop_closure = false;
+    else ok = false;
+  }
+  else if (key == "loop_points") ok = integer(&t.loop_points);
+  else if (key == "loop_icp_max_correspondence_m") ok = real(&t.loop_icp_max_correspondence_m);
+  else if (key == "loop_max_error_m") ok = real(&t.loop_max_error_m);
+  else if (key == "loop_min_pairs") ok = integer(&t.loop_min_pairs);
+  else if (key == "loop_max_correction_m") ok = real(&t.loop_max_correction_m);
+  else if (key == "segment_sigma_xy_m") ok = real(&t.segment_sigma_xy_m);
+  else if (key == "segment_sigma_theta_rad") ok = real(&t.segment_sigma_theta_rad);
+  else if (key == "loop_sigma_xy_m") ok = real(&t.loop_sigma_xy_m);
+  else if (key == "loop_sigma_theta_rad") ok = real(&t.loop_sigma_theta_rad);
+  else if (key == "loop_robust_chi") ok = real(&t.loop_robust_chi);
+  else if (key == "max_loop_constraints") ok = integer(&t.max_loop_constraints);
+  else if (key == "graph_iterations") ok = integer(&t.graph_iterations);
   else return SdpKeyResult::kUnknown;
   if (!ok) {
     if (why != nullptr) *why = "[sdp] " + key + ": malformed value '" + v + "'";
@@ -260,7 +271,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     *error = std::string("SDP-SLAM init failed: ") + slam->why();
     return SdpRunStatus::kInternal;
   }
-  CollectSink permanent;
+  SdpPermanentPath permanent;
   Rows rows;
   slam->set_permanent_sink(&permanent);
   slam->set_listener(&rows);
@@ -303,7 +314,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   // The best combination's path: permanent segments, then the live chain.
   std::uint64_t path_gaps = 0U;
   const std::vector<io::StampedPose> trajectory =
-      assemble_trajectory(scans, sdp_best_path(*slam, permanent.poses), &path_gaps);
+      assemble_trajectory(scans, sdp_best_path(*slam, permanent), &path_gaps);
 
   io::OccupancyImage image;
   const std::uint32_t known_cells = sdp_global_map_image(*slam, &image);

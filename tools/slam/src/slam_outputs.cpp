@@ -73,8 +73,33 @@ bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::
 
 // ---- SDP-SLAM ------------------------------------------------------------------------
 
-std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const std::vector<io::StampedPose>& permanent) {
-  std::vector<io::StampedPose> path = permanent;
+void SdpPermanentPath::on_pose(std::uint32_t level, std::int64_t stamp_us, const Pose2& local) {
+  if (bounded_ && poses_.size() >= poses_.capacity()) {
+    ++dropped_;
+    return;
+  }
+  poses_.push_back(LocalPose{level, stamp_us, local});
+}
+
+void SdpPermanentPath::on_frame(std::uint32_t level, const Pose2& frame_in_global) {
+  if (level >= frames_.size()) {
+    if (bounded_ && level >= frames_.capacity()) return;  // its poses were not stored either
+    frames_.resize(level + 1U);
+  }
+  frames_[level] = frame_in_global;
+}
+
+std::vector<io::StampedPose> SdpPermanentPath::global_poses() const {
+  std::vector<io::StampedPose> out;
+  out.reserve(poses_.size());
+  for (const LocalPose& p : poses_) {
+    if (p.level < frames_.size()) out.push_back({p.stamp_us, frames_[p.level].compose(p.local)});
+  }
+  return out;
+}
+
+std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermanentPath& permanent) {
+  std::vector<io::StampedPose> path = permanent.global_poses();
   slam.for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
   return path;
 }
@@ -185,6 +210,13 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
         ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
         ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
+  js += "  \"bottom_proposal\": \"" +
+        std::string(bottom.options().proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry") + "\",\n";
+  js += "  \"loop_closure\": {\"enabled\": " + std::string(so.loop_closure ? "true" : "false") + ", \"records\": " +
+        u(st.loop_records) + ", \"refinements\": " + u(st.loop_refinements) + ", \"added\": " + u(st.loop_records_added) + ", \"dropped\": " +
+        u(st.loop_records_dropped) + ", \"used_last\": " + u(st.loop_constraints_used) + ", \"downweighted_last\": " +
+        u(st.loop_downweighted) + ", \"adjustments\": " + u(st.frame_adjustments) + ", \"graph_refused\": " +
+        u(st.frame_graph_refused) + "},\n";
   js += "  \"pools\": {\n";
   js += filter_pools_json(bottom);
   js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +

@@ -120,6 +120,12 @@ static_assert(kMaxTopParticles >= 1U && kMaxTopParticles <= 4096U, "kMaxTopParti
 // the oldest are forgotten (counted), their map is already in the global map.
 inline constexpr std::uint32_t kMaxPermanentSubmaps = SDPSLAM_MAX_PERMANENT_SUBMAPS;
 static_assert(kMaxPermanentSubmaps >= 1U && kMaxPermanentSubmaps <= 65536U, "kMaxPermanentSubmaps out of range");
+// Loop-closure constraints SDP-SLAM keeps between submap frames (frame_graph.h).
+#ifndef SDPSLAM_MAX_LOOP_CONSTRAINTS
+#define SDPSLAM_MAX_LOOP_CONSTRAINTS 16384
+#endif
+inline constexpr std::uint32_t kMaxLoopConstraints = SDPSLAM_MAX_LOOP_CONSTRAINTS;
+static_assert(kMaxLoopConstraints >= 1U && kMaxLoopConstraints <= 1048576U, "kMaxLoopConstraints out of range");
 // Bottom particles per segment in SDP-SLAM: a PGS level holds one node per particle and a
 // top-level choice is stored in 16 bits.
 static_assert(kMaxPgsNodesPerLevel <= 65535U, "PGS node index must fit 16 bits");

@@ -36,12 +36,26 @@
 // follow the best particle's (a local analysis of chains of few segments).
 //
 // Bounded memory: when all max_levels PGS levels are live, the oldest becomes PERMANENT
-// with the best top particle's choice: that submap's poses go to the permanent pose
-// sink in the global frame, its map is copied into one global "permanent map" node
-// (a tree root that is not a particle) and its skeleton into a ring of permanent
+// with the best top particle's choice: that submap's poses go to the permanent path
+// sink (SdpPathSink: the poses in its frame, and that frame in the global frame), its
+// map is copied into one global "permanent map" node (a tree root that is not a
+// particle) and its skeleton into a ring of permanent
 // submaps (still matched for loop closures); the level's other submaps are released
 // (set_active(false) + prune frees their DP-map observations; counted), one submap per
 // call of process() so that no single scan pays for all of them.
+//
+// Loop closure (beyond the paper, SdpOptions::loop_closure): when the skeleton ICP of
+// two non-adjacent submaps succeeds, ICP on their obstacle points (wall cells that
+// border free space, kept per submap at anchorage) refines it; a refined match with a
+// small residual and a bounded correction is kept as a constraint between the two
+// LEVELS' frames (all submaps of a level share its frame: the bottom particles restarted
+// at one pose), one per pair of levels. After every ranking, the frames of the best
+// combination — the permanent submaps still held and the chosen live submaps — are
+// adjusted by a pose graph (frame_graph.h) whose chain constraints are the transforms T
+// of Fig. 3 (l) and whose loops are those constraints. Permanent frames and the PGS
+// anchor move with it, so later samples are placed from the corrected frames; the
+// permanent path sink is told every new frame, so the trajectory follows. The global
+// map's permanent part keeps the frames its submaps had when they were copied into it.
 //
 // Worst-scan time: anchorage work (skeleton extraction, map transfer) is done in chunks
 // of at most work_cells_per_scan map cells per call of process(), and top-level samples
@@ -55,6 +69,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/frame_graph.h"
 #include "sdpslam/core/free_space_skeleton.h"
 #include "sdpslam/core/icp2d.h"
 #include "sdpslam/core/sdp_options.h"
@@ -89,6 +104,14 @@ struct SdpStats {
   std::uint64_t icp_matches = 0U;
   std::uint64_t icp_failures = 0U;          // overlapping boxes, too few correspondences
   std::uint64_t icp_memo_hits = 0U;         // pair results reused instead of recomputed
+  std::uint64_t loop_records = 0U;          // loop constraints held now
+  std::uint64_t loop_refinements = 0U;      // obstacle-point ICP runs
+  std::uint64_t loop_records_added = 0U;    // ICP matches kept as loop constraints
+  std::uint64_t loop_records_dropped = 0U;  // kept matches that found no room (store full)
+  std::uint64_t loop_constraints_used = 0U; // in the last adjustment
+  std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
+  std::uint64_t frame_adjustments = 0U;     // pose-graph solves
+  std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
   std::uint32_t max_live_levels = 0U;
@@ -107,6 +130,18 @@ class TopLevelListener {
 
  protected:
   ~TopLevelListener() = default;
+};
+
+// Receives the path of the segments made permanent: every pose once, in its level's
+// submap frame, and the level's frame in the global frame whenever it is set or moved by
+// loop closure. A pose's global place is frame(level) ⊕ local.
+class SdpPathSink {
+ public:
+  virtual void on_pose(std::uint32_t level, std::int64_t stamp_us, const Pose2& local) = 0;
+  virtual void on_frame(std::uint32_t level, const Pose2& frame_in_global) = 0;
+
+ protected:
+  ~SdpPathSink() = default;
 };
 
 class SdpSlam {
@@ -131,8 +166,8 @@ class SdpSlam {
   // outputs are read at the end of a run. Not bounded by the per-scan budget.
   void finish();
 
-  // Poses of segments made permanent, in the global frame, in time order. Not owned.
-  void set_permanent_sink(PoseSink* sink) { permanent_sink_ = sink; }
+  // Path of the segments made permanent (see SdpPathSink), in time order. Not owned.
+  void set_permanent_sink(SdpPathSink* sink) { permanent_sink_ = sink; }
   void set_listener(TopLevelListener* listener) { listener_ = listener; }
 
   // ---- the best combination ---------------------------------------------------------
@@ -176,6 +211,7 @@ class SdpSlam {
     CellRect map_rect{};                    // cells worth reading for its map
     CellRect path_rect{};                   // its path's cells (skeleton patch seed)
     std::uint32_t point_count = 0U;
+    std::uint32_t obstacle_count = 0U;  // loop closure's obstacle points
     bool skeleton_done = false;
   };
   struct Level {
@@ -185,9 +221,26 @@ class SdpSlam {
   };
   struct Permanent {
     Pose2 frame_in_global;
+    Pose2 from_previous;  // this frame in the previous permanent level's frame (chain T)
     double box[4] = {0.0, 0.0, 0.0, 0.0};
     std::uint32_t level = 0U;
     std::uint32_t point_count = 0U;
+    std::uint32_t obstacle_count = 0U;
+    std::uint16_t node = 0U;  // the chosen submap of the level
+  };
+  // An obstacle point in half DP-map cells from the map's origin (the submap frame is the
+  // map's grid frame).
+  struct CellPoint {
+    std::uint16_t ix = 0U;
+    std::uint16_t iy = 0U;
+  };
+  // A loop constraint: the pose of the newer level's frame in the older one's, as ICP on
+  // obstacle points found it, with the residual it left.
+  struct LoopRecord {
+    std::uint32_t older_level = 0U;
+    std::uint32_t newer_level = 0U;
+    Pose2 z;
+    double error_m = 0.0;
   };
   // Memo of ICP results: many samples share a pair of submaps placed identically (elite
   // copies, common chains), and ICP is deterministic, so the same inputs give the same
@@ -227,6 +280,15 @@ class SdpSlam {
   Point2* perm_points(std::uint32_t index) const {
     return perm_points_ + static_cast<std::size_t>(index) * options_.skeleton_points;
   }
+  CellPoint* live_obstacles(std::uint32_t level, std::uint32_t node) const {
+    return live_obst_ + (static_cast<std::size_t>(slot(level)) * n_bottom_ + node) * options_.loop_points;
+  }
+  CellPoint* perm_obstacles(std::uint32_t index) const {
+    return perm_obst_ + static_cast<std::size_t>(index) * options_.loop_points;
+  }
+  void extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch);
+  // Cell points → metres in the submap frame (scratch buffer); returns the count.
+  std::uint32_t unpack(const CellPoint* in, std::uint32_t n, Point2* out) const;
   std::uint16_t& choice(std::uint32_t particle, std::uint32_t level) {
     return choices_[particle * options_.max_levels + slot(level)];
   }
@@ -254,6 +316,13 @@ class SdpSlam {
   void end_round(std::int64_t stamp_us, bool may_continue);
   void update_best();
   double key(std::uint32_t particle) const;
+  // Ring index of permanent level `level` if it is still held.
+  bool permanent_slot(std::uint32_t level, std::uint32_t* pi) const;
+  // Index of a level's frame in the best combination's frame graph, if it is part of it.
+  bool graph_index(std::uint32_t level, std::uint32_t* index) const;
+  bool loop_record_dead(const LoopRecord& r) const;
+  void record_loop(const LoopRecord& r);
+  void adjust_frames();
 
   SdpOptions options_{};
   DpSlamOptions bottom_options_{};
@@ -264,7 +333,7 @@ class SdpSlam {
   Segmenter* segmenter_ = nullptr;
   Rng rng_;
   RingSink ring_sink_{*this};
-  PoseSink* permanent_sink_ = nullptr;
+  SdpPathSink* permanent_sink_ = nullptr;
   TopLevelListener* listener_ = nullptr;
   SdpStats stats_{};
 
@@ -296,6 +365,13 @@ class SdpSlam {
   CellState* coarse_ = nullptr;
   std::uint32_t coarse_side_ = 0U;
   IcpMemo* memo_ = nullptr;  // kIcpMemoSlots
+  LoopRecord* loops_ = nullptr;  // max_loop_constraints
+  CellPoint* live_obst_ = nullptr;  // max_levels × N × loop_points
+  CellPoint* perm_obst_ = nullptr;  // max_permanent_submaps × loop_points
+  Point2* obst_a_ = nullptr;        // loop_points (scratch)
+  Point2* obst_b_ = nullptr;
+  std::uint32_t loop_count_ = 0U;
+  FrameGraph frame_graph_;
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N

@@ -193,6 +193,12 @@ class SegmentGraph {
   // The most recent permanent node and its frame in the global frame (valid iff has_anchor()).
   const PgsNode& anchor() const { return anchor_; }
   const Pose2& anchor_frame() const { return anchor_frame_; }
+  // Moves the anchor's frame (loop closure adjusted it); later chains compose from it.
+  // Ignored (counted as misuse) without an anchor.
+  void set_anchor_frame(const Pose2& frame) {
+    if (has_anchor()) anchor_frame_ = frame;
+    else ++misuse_count_;
+  }
 
   // ---- diagnostics ------------------------------------------------------------------
   std::uint32_t levels_used() const { return live_count_; }

@@ -52,10 +52,39 @@ bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::
 
 // ---- SDP-SLAM ------------------------------------------------------------------------
 
-// The best combination's path, oldest first: `permanent` (what SdpSlam's permanent pose
-// sink received: the segments made permanent, global frame) followed by the live levels'
-// chosen submaps and the current segment's best particle (SdpSlam::for_each_best_pose).
-std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const std::vector<io::StampedPose>& permanent);
+// The path of SDP-SLAM's permanent segments (SdpSlam::set_permanent_sink): each pose
+// in its level's frame, and each level's latest frame in the global frame (loop closure
+// moves them). With a capacity (reserve()), poses beyond it are counted in `dropped`
+// instead of stored, so the onboard program's memory stays bounded.
+class SdpPermanentPath final : public SdpPathSink {
+ public:
+  struct LocalPose {
+    std::uint32_t level;
+    std::int64_t stamp_us;
+    Pose2 local;
+  };
+  void reserve(std::size_t poses, std::size_t levels) {
+    poses_.reserve(poses);
+    frames_.reserve(levels);
+    bounded_ = true;
+  }
+  void on_pose(std::uint32_t level, std::int64_t stamp_us, const Pose2& local) override;
+  void on_frame(std::uint32_t level, const Pose2& frame_in_global) override;
+  // The poses in the global frame, oldest first.
+  std::vector<io::StampedPose> global_poses() const;
+  std::uint64_t dropped() const { return dropped_; }
+
+ private:
+  std::vector<LocalPose> poses_;
+  std::vector<Pose2> frames_;  // by level
+  bool bounded_ = false;
+  std::uint64_t dropped_ = 0U;
+};
+
+// The best combination's path, oldest first: the permanent segments (in their latest
+// frames) followed by the live levels' chosen submaps and the current segment's best
+// particle (SdpSlam::for_each_best_pose).
+std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermanentPath& permanent);
 
 // The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map node plus
 // each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
