@@ -49,6 +49,10 @@ bool inverse3(const double* m, double* out) {
   out[8] = (m[0] * m[4] - m[1] * m[3]) * inv;
   return true;
 }
+// eᵀ Ω e for a diagonal Ω.
+double weighted_sq(const FrameInfo& info, const double* e) {
+  return info.xy * (e[0] * e[0] + e[1] * e[1]) + info.theta * e[2] * e[2];
+}
 double dot(const double* a, const double* b, std::size_t n) {
   double s = 0.0;
   for (std::size_t k = 0; k < n; ++k) s += a[k] * b[k];
@@ -147,7 +151,7 @@ void FrameGraph::linearise(const Constraint& c, Linear& l) const {
 double FrameGraph::chi2(const Constraint& c) const {
   Linear l;
   linearise(c, l);
-  return c.info.xy * (l.e[0] * l.e[0] + l.e[1] * l.e[1]) + c.info.theta * l.e[2] * l.e[2];
+  return weighted_sq(c.info, l.e);
 }
 
 // H v over nodes 1..n-1 (node 0 is fixed: its entries of v are 0 and of out unused).
@@ -251,15 +255,13 @@ void FrameGraph::optimise() {
     for (std::uint32_t q = 0; q < loops_; ++q) s += c2 * det::log(1.0 + chi2(loop_[q]) / c2);
     return s;
   };
-  for (std::uint32_t q = 0; q < loops_; ++q) loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / c2);
   stats_.last_chi2_before = total_chi2();
   for (std::uint32_t it = 0; it < options_.iterations; ++it) {
     for (std::uint32_t k = 1; k < n_; ++k) linearise(seq_[k], lin_[k]);
     for (std::uint32_t q = 0; q < loops_; ++q) {
       Linear& l = lin_[options_.max_nodes + q];
       linearise(loop_[q], l);
-      const double e2 = loop_[q].info.xy * (l.e[0] * l.e[0] + l.e[1] * l.e[1]) + loop_[q].info.theta * l.e[2] * l.e[2];
-      l.w = 1.0 / (1.0 + e2 / c2);
+      l.w = 1.0 / (1.0 + weighted_sq(loop_[q].info, l.e) / c2);
       loop_w_[q] = l.w;
     }
     // b = Σ Jᵀ Ω e; r = −b (Δ = 0 to start).

@@ -11,7 +11,6 @@ namespace {
 
 constexpr std::size_t kSlack = 64U;
 
-
 std::uint32_t fine_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
   return static_cast<std::uint32_t>(s.skeleton_max_side_m / b.map_resolution_m) + 2U;
 }
@@ -471,7 +470,6 @@ void SdpSlam::make_oldest_permanent() {
   for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
   pm.level = level;
   pm.point_count = sm.point_count;
-  pm.node = static_cast<std::uint16_t>(chosen);
   pm.obstacle_count = 0U;
   if (options_.loop_closure) {
     const CellPoint* from = live_obstacles(level, chosen);
@@ -966,7 +964,7 @@ void SdpSlam::extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, s
   sm.obstacle_count = n;
 }
 
-std::uint32_t SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
+void SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
   const DpMap& map = filter_->map();
   const double half = 0.5 * map.resolution_m();
   const double ox = map.options().origin_x_m;
@@ -975,7 +973,6 @@ std::uint32_t SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out)
     out[i].x_m = ox + static_cast<double>(in[i].ix) * half;
     out[i].y_m = oy + static_cast<double>(in[i].iy) * half;
   }
-  return n;
 }
 
 bool SdpSlam::permanent_slot(std::uint32_t level, std::uint32_t* pi) const {

@@ -226,7 +226,6 @@ class SdpSlam {
     std::uint32_t level = 0U;
     std::uint32_t point_count = 0U;
     std::uint32_t obstacle_count = 0U;
-    std::uint16_t node = 0U;  // the chosen submap of the level
   };
   // An obstacle point in half DP-map cells from the map's origin (the submap frame is the
   // map's grid frame).
@@ -287,8 +286,8 @@ class SdpSlam {
     return perm_obst_ + static_cast<std::size_t>(index) * options_.loop_points;
   }
   void extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch);
-  // Cell points → metres in the submap frame (scratch buffer); returns the count.
-  std::uint32_t unpack(const CellPoint* in, std::uint32_t n, Point2* out) const;
+  // Cell points → metres in the submap frame (scratch buffer).
+  void unpack(const CellPoint* in, std::uint32_t n, Point2* out) const;
   std::uint16_t& choice(std::uint32_t particle, std::uint32_t level) {
     return choices_[particle * options_.max_levels + slot(level)];
   }
