@@ -102,17 +102,19 @@ bool FrameGraph::add_node(const Pose2& estimate, const Pose2& from_previous, con
     return false;
   }
   pose_[n_] = estimate;
-  seq_[n_] = Constraint{n_ > 0U ? n_ - 1U : 0U, n_, from_previous, info};
+  seq_[n_] = Constraint{n_ > 0U ? n_ - 1U : 0U, n_, from_previous, info, 0.0};
   ++n_;
   return true;
 }
 
-bool FrameGraph::add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info) {
-  if (!initialised_ || loops_ >= options_.max_loops || i >= n_ || j >= n_ || i == j) {
+bool FrameGraph::add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info, double robust_chi) {
+  if (!initialised_ || loops_ >= options_.max_loops || i >= n_ || j >= n_ || i == j || robust_chi < 0.0 ||
+      !(robust_chi == robust_chi)) {
     ++stats_.refused_loops;
     return false;
   }
-  loop_[loops_] = Constraint{i, j, z, info};
+  const double c = robust_chi > 0.0 ? robust_chi : options_.robust_chi;
+  loop_[loops_] = Constraint{i, j, z, info, c * c};
   loop_w_[loops_] = 1.0;
   ++loops_;
   return true;
@@ -247,12 +249,11 @@ void FrameGraph::optimise() {
   double* hp = work_ + 4U * m;
   // work_ + 15·max_nodes .. 18·max_nodes: the preconditioner's y (see precondition()).
   const std::size_t dim = 3U * n_;
-  const double c2 = options_.robust_chi * options_.robust_chi;
-  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy).
+  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy, c per loop).
   auto total_chi2 = [&]() {
     double s = 0.0;
     for (std::uint32_t k = 1; k < n_; ++k) s += chi2(seq_[k]);
-    for (std::uint32_t q = 0; q < loops_; ++q) s += c2 * det::log(1.0 + chi2(loop_[q]) / c2);
+    for (std::uint32_t q = 0; q < loops_; ++q) s += loop_[q].c2 * det::log(1.0 + chi2(loop_[q]) / loop_[q].c2);
     return s;
   };
   stats_.last_chi2_before = total_chi2();
@@ -261,7 +262,7 @@ void FrameGraph::optimise() {
     for (std::uint32_t q = 0; q < loops_; ++q) {
       Linear& l = lin_[options_.max_nodes + q];
       linearise(loop_[q], l);
-      l.w = 1.0 / (1.0 + weighted_sq(loop_[q].info, l.e) / c2);
+      l.w = 1.0 / (1.0 + weighted_sq(loop_[q].info, l.e) / loop_[q].c2);
       loop_w_[q] = l.w;
     }
     // b = Σ Jᵀ Ω e; r = −b (Δ = 0 to start).
@@ -317,7 +318,7 @@ void FrameGraph::optimise() {
   }
   std::uint32_t down = 0U;
   for (std::uint32_t q = 0; q < loops_; ++q) {
-    loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / c2);
+    loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / loop_[q].c2);
     if (loop_w_[q] < 0.5) ++down;
   }
   stats_.last_chi2_after = total_chi2();

@@ -33,15 +33,15 @@ struct Rig {
   Arena arena{buffer, sizeof buffer};
   FrameGraph graph;
   std::vector<Pose2> truth = square_truth();
-  // Sequential measurements with a heading bias of 0.02 rad per step: the chain drifts.
-  void build_drifting_chain() {
+  // Sequential measurements with a heading bias (rad per step): the chain drifts.
+  void build_drifting_chain(double bias_rad = 0.02) {
     graph.clear();
     Pose2 est = truth[0];
     for (std::size_t k = 0; k < truth.size(); ++k) {
       Pose2 z;
       if (k > 0) {
         z = between(truth[k - 1], truth[k]);
-        z.heading_rad += 0.02;
+        z.heading_rad += bias_rad;
         est = est.compose(z);
       }
       CHECK_TRUE(graph.add_node(k == 0 ? truth[0] : est, z, FrameInfo::from_sigma(0.1, 0.02)));
@@ -95,6 +95,30 @@ TEST(FrameGraph, a_wrong_loop_constraint_among_good_ones_is_down_weighted) {
   CHECK_TRUE(rig->graph.loop_weight(3) < 0.1);
   CHECK_TRUE(rig->graph.loop_weight(0) > 0.5);
   CHECK_TRUE(position_error(rig->graph.frame(15), t[15]) < 0.3);
+}
+
+// After a long loop the chain is metres off: with the options' narrow kernel the true
+// loop constraint is discounted as an outlier; given a wide kernel of its own it
+// closes the loop. Bad kernel scales are refused.
+TEST(FrameGraph, a_loop_with_its_own_wide_kernel_closes_a_drift_of_metres) {
+  const FrameInfo info = FrameInfo::from_sigma(0.1, 0.02);
+  const std::vector<Pose2>& t = rig->truth;
+  rig->build_drifting_chain(0.06);
+  const double before = position_error(rig->graph.frame(15), t[15]);
+  CHECK_TRUE(before > 3.0);
+  CHECK_TRUE(rig->graph.add_loop(0, 15, between(t[0], t[15]), info));  // options' scale, 3
+  rig->graph.optimise();
+  const double narrow = position_error(rig->graph.frame(15), t[15]);
+  CHECK_TRUE(rig->graph.loop_weight(0) < 0.1);
+  rig->build_drifting_chain(0.06);
+  CHECK_TRUE(rig->graph.add_loop(0, 15, between(t[0], t[15]), info, 300.0));
+  rig->graph.optimise();
+  const double wide = position_error(rig->graph.frame(15), t[15]);
+  CHECK_TRUE(rig->graph.loop_weight(0) > 0.5);
+  CHECK_TRUE(wide < 0.1);
+  CHECK_TRUE(narrow > 5.0 * wide);
+  CHECK_FALSE(rig->graph.add_loop(0, 15, Pose2{}, info, -1.0));
+  CHECK_FALSE(rig->graph.add_loop(0, 15, Pose2{}, info, std::nan("")));
 }
 
 TEST(FrameGraph, capacities_refuse_and_count_and_bad_indices_are_refused) {

@@ -71,9 +71,10 @@ class FrameGraph {
   // Appends node k with its current estimate; for k >= 1 also its sequential
   // constraint: `from_previous` is the pose of frame k in frame k-1. False when full.
   bool add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info);
-  // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added). False
-  // when full or the indices are bad.
-  bool add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info);
+  // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added), behind
+  // a Cauchy kernel of scale robust_chi (0 = the options' scale). False when full or
+  // the indices or the scale are bad.
+  bool add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info, double robust_chi = 0.0);
   // Gauss-Newton over nodes 1 .. n-1; node 0 stays where it is.
   void optimise();
 
@@ -90,6 +91,7 @@ class FrameGraph {
     std::uint32_t j = 0U;
     Pose2 z;
     FrameInfo info;
+    double c2 = 0.0;  // loops: squared Cauchy scale
   };
   // Linearised constraint: e, A = ∂e/∂X_i, B = ∂e/∂X_j (row-major 3×3), weight.
   struct Linear {
