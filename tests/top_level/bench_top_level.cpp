@@ -1,12 +1,16 @@
 // Timing of the top-level building blocks: ICP between two 500-point sets and
-// free-space skeleton extraction on a 200×200 patch. Prints figures; build Release.
+// free-space skeleton extraction on a 200×200 patch, and the wide loop search
+// (correlative matching of two 300-point sets over ±3 m and ±6 m, ±0.35 rad). Prints
+// figures; build Release.
 //   bench_top_level [repetitions]
 #include <chrono>
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 
 #include "sdpslam/core/arena.h"
+#include "sdpslam/core/correlative_matcher.h"
 #include "sdpslam/core/free_space_skeleton.h"
 #include "sdpslam/core/icp2d.h"
 #include "top_level_fixtures.h"
@@ -22,6 +26,9 @@ sdpslam::Point2 g_source[500];
 sdpslam::CellState g_cells[200U * 200U];
 sdpslam::Point2 g_points[1024];
 alignas(16) unsigned char g_buffer[1U << 20U];
+sdpslam::Point2 g_outline[4096];
+sdpslam::Point2 g_cm_target[300];
+sdpslam::Point2 g_cm_source[300];
 
 double micros(Clock::duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
 // Process CPU time: less disturbed than wall time when the machine is shared.
@@ -113,5 +120,51 @@ int main(int argc, char** argv) {
   std::printf("free_space_skeleton 200x200 cells: wall mean %.1f us, min %.1f us, cpu mean %.1f us per patch "
               "(%d runs); %u ridge cells, %u points, arena %zu bytes\n",
               sk_total_us / sk_reps, sk_min_us, sk_cpu_us, sk_reps, s.ridge_cell_count, s.point_count, arena.used_bytes());
+  // Wide loop search: walls of a 20 m × 12 m floor (rooms off a corridor) thinned to
+  // 300 points, as a submap's obstacle points are; the source is the same walls moved
+  // by (2.3 m, -1.7 m, 0.15 rad). Grid side 318 cells of 0.1 m, as in best.ini.
+  {
+    using sdpslam::test::add_segment;
+    std::size_t n = 0U;
+    n = add_segment(g_outline, n, 4096U, 0.0, 0.0, 20.0, 0.0, 0.05);
+    n = add_segment(g_outline, n, 4096U, 20.0, 0.0, 20.0, 12.0, 0.05);
+    n = add_segment(g_outline, n, 4096U, 20.0, 12.0, 0.0, 12.0, 0.05);
+    n = add_segment(g_outline, n, 4096U, 0.0, 12.0, 0.0, 0.0, 0.05);
+    n = add_segment(g_outline, n, 4096U, 0.0, 5.0, 14.0, 5.0, 0.05);
+    n = add_segment(g_outline, n, 4096U, 0.0, 7.0, 17.0, 7.0, 0.05);
+    for (int k = 0; k < 4; ++k) {
+      n = add_segment(g_outline, n, 4096U, 3.5 + 4.0 * k, 0.0, 3.5 + 4.0 * k, 4.0, 0.05);
+      n = add_segment(g_outline, n, 4096U, 2.0 + 5.0 * k, 7.0, 2.0 + 5.0 * k, 10.5 - 0.7 * k, 0.05);
+    }
+    for (std::size_t i = 0; i < 300U; ++i) g_cm_target[i] = g_outline[i * n / 300U];
+    const sdpslam::Pose2 moved{2.3, -1.7, 0.15};
+    sdpslam::test::transform_points(moved.inverse(), g_cm_target, g_cm_source, 300U);
+    sdpslam::Arena cm_arena(g_buffer, sizeof g_buffer);
+    sdpslam::CorrelativeMatcher matcher;
+    if (!matcher.init(318U, 300U, sdpslam::CorrelativeMatcher::steps_for(6.0, 0.1, 4U), cm_arena)) {
+      std::fprintf(stderr, "bench_top_level: correlative matcher init failed\n");
+      return 1;
+    }
+    for (double window_m : {3.0, 6.0}) {
+      sdpslam::CorrelativeOptions co;
+      co.window_xy_m = window_m;
+      const int cm_reps = reps / 20 > 0 ? reps / 20 : 1;
+      sdpslam::CorrelativeResult c;
+      double max_us = 0.0;
+      const std::clock_t cm_cpu0 = std::clock();
+      for (int i = 0; i < cm_reps; ++i) {
+        const auto t0 = Clock::now();
+        c = matcher.match(g_cm_target, 300U, g_cm_source, 300U, sdpslam::Pose2{}, co);
+        const double us = micros(Clock::now() - t0);
+        max_us = us > max_us ? us : max_us;
+      }
+      const double cm_cpu_us = cpu_us(std::clock() - cm_cpu0) / cm_reps;
+      std::printf("correlative_matcher 300x300 points, +-%.0f m, +-%.2f rad: cpu mean %.0f us, wall max %.0f us per "
+                  "search (%d runs); %u poses scored, found %d, score %.3f (second %.3f), error (%.3f m, %.3f m, %.4f rad)\n",
+                  window_m, co.window_theta_rad, cm_cpu_us, max_us, cm_reps, c.poses_scored, c.found() ? 1 : 0, c.score,
+                  c.second_score, c.transform.x_m - moved.x_m, c.transform.y_m - moved.y_m,
+                  c.transform.heading_rad - moved.heading_rad);
+    }
+  }
   return 0;
 }
