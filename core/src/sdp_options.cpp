@@ -85,6 +85,13 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("loop_robust_chi", loop_robust_chi, 1.0e-3, 1.0e3);
   c.integer("max_loop_constraints", max_loop_constraints, 1U, capacity::kMaxLoopConstraints);
   c.integer("graph_iterations", graph_iterations, 1U, 50U);
+  c.real("loop_search_window_m", loop_search_window_m, 0.0, 20.0);
+  c.real("loop_search_window_rad", loop_search_window_rad, 0.0, 3.14159265358979323846);
+  c.real("loop_search_min_score", loop_search_min_score, 1.0e-6, 1.0);
+  c.real("loop_search_max_ambiguity", loop_search_max_ambiguity, 1.0e-6, 1.0);
+  c.integer("loop_search_candidates", loop_search_candidates, 1U, kMaxLoopSearchCandidates);
+  c.real("loop_search_robust_chi", loop_search_robust_chi, 1.0e-3, 1.0e3);
+  c.integer("loop_search_reads_per_scan", loop_search_reads_per_scan, 10000U, 1000000000U);
   if (c.ok && !icp.valid()) c.fail("icp: options out of range (see icp2d.h Icp2dOptions::valid)");
   return c.ok;
 }

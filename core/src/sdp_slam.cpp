@@ -18,6 +18,17 @@ std::uint32_t coarse_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
   return fine_side_cells(b, s) / s.skeleton_downsample + 2U;
 }
 std::uint32_t ring_capacity_for(const SdpOptions& s) { return (s.max_levels + 2U) * (s.max_segment_scans + 2U); }
+// Wide loop search grid: a skeleton patch of coarse cells plus the reach of a kernel of
+// 1.5 cells (2 × (5 + 2) cells, correlative_matcher.cpp).
+std::uint32_t search_grid_side(std::size_t coarse_side) { return static_cast<std::uint32_t>(coarse_side) + 16U; }
+// The search works on obstacle points, which lie on the skeleton's coarse cells.
+double search_resolution_m(const DpSlamOptions& b, const SdpOptions& s) {
+  return b.map_resolution_m * static_cast<double>(s.skeleton_downsample);
+}
+constexpr std::uint32_t kSearchCoarseCells = 4U;
+std::uint32_t search_steps(const DpSlamOptions& b, const SdpOptions& s) {
+  return CorrelativeMatcher::steps_for(s.loop_search_window_m, search_resolution_m(b, s), kSearchCoarseCells);
+}
 
 // The loop-closure graph holds every permanent submap still kept and every live level.
 FrameGraphOptions frame_graph_options(const SdpOptions& s) {
@@ -129,6 +140,10 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
     total += Arena::bytes_for<LoopRecord>(s.max_loop_constraints) + FrameGraph::required_bytes(frame_graph_options(s));
     total += Arena::bytes_for<CellPoint>((L * n + s.max_permanent_submaps) * std::size_t{s.loop_points}) +
              2U * Arena::bytes_for<Point2>(s.loop_points);
+    if (s.loop_search_window_m > 0.0) {
+      total += CorrelativeMatcher::required_bytes(search_grid_side(cs), s.loop_points, search_steps(b, s)) +
+               2U * Arena::bytes_for<Point2>(s.loop_points);
+    }
   }
   total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
   return total + kSlack;
@@ -199,18 +214,31 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
   memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
   loop_count_ = 0U;
+  search_level_ = 0U;
+  search_count_ = 0U;
+  search_cursor_ = 0U;
   if (s.loop_closure) {
     loops_ = arena.allocate_array<LoopRecord>(s.max_loop_constraints);
     live_obst_ = arena.allocate_array<CellPoint>(std::size_t{L} * n_bottom_ * s.loop_points);
     perm_obst_ = arena.allocate_array<CellPoint>(std::size_t{s.max_permanent_submaps} * s.loop_points);
     obst_a_ = arena.allocate_array<Point2>(s.loop_points);
     obst_b_ = arena.allocate_array<Point2>(s.loop_points);
+    if (s.loop_search_window_m > 0.0) {
+      search_a_ = arena.allocate_array<Point2>(s.loop_points);
+      search_b_ = arena.allocate_array<Point2>(s.loop_points);
+      if (search_a_ == nullptr || search_b_ == nullptr) {
+        std::snprintf(why_, sizeof why_, "arena exhausted (loop search)");
+        return false;
+      }
+    }
     if (b.map_width_m / b.map_resolution_m > 32767.0 || b.map_height_m / b.map_resolution_m > 32767.0) {
       std::snprintf(why_, sizeof why_, "sdp.loop_closure: the map grid is wider than 32767 cells");
       return false;
     }
     if (loops_ == nullptr || live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr ||
-        obst_b_ == nullptr || !frame_graph_.init(frame_graph_options(s), arena)) {
+        obst_b_ == nullptr || !frame_graph_.init(frame_graph_options(s), arena) ||
+        (s.loop_search_window_m > 0.0 &&
+         !matcher_.init(search_grid_side(coarse_side_), s.loop_points, search_steps(b, s), arena))) {
       std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");
       return false;
     }
@@ -347,6 +375,7 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
     }
     if (eval_cursor_ >= n_top_) end_round(scan.stamp_us, true);
   }
+  if (options_.loop_closure && options_.loop_search_window_m > 0.0 && !work_pending && started_) loop_search_step();
   result.pose = current_frame_.compose(result.bottom.pose);
   return result;
 }
@@ -1015,7 +1044,11 @@ void SdpSlam::record_loop(const LoopRecord& r) {
   for (std::uint32_t k = 0; k < loop_count_; ++k) {
     LoopRecord& q = loops_[k];
     if (q.older_level == r.older_level && q.newer_level == r.newer_level) {
-      if (r.error_m < q.error_m) q = r;
+      if (r.error_m < q.error_m) {
+        const bool searched = q.searched || r.searched;
+        q = r;
+        q.searched = searched;
+      }
       return;
     }
     if (dead == loop_count_ && loop_count_ == options_.max_loop_constraints && loop_record_dead(q)) dead = k;
@@ -1068,7 +1101,7 @@ void SdpSlam::adjust_frames() {
     const LoopRecord& r = loops_[k];
     std::uint32_t a = 0U, b = 0U;
     if (!graph_index(r.older_level, &a) || !graph_index(r.newer_level, &b)) continue;
-    if (g.add_loop(a, b, r.z, loop)) {
+    if (g.add_loop(a, b, r.z, loop, r.searched ? options_.loop_search_robust_chi : options_.loop_robust_chi)) {
       ++used;
     } else {
       ++stats_.frame_graph_refused;
@@ -1086,6 +1119,180 @@ void SdpSlam::adjust_frames() {
   }
   if (perm_count_ > 0U) graph_.set_anchor_frame(g.frame(perm_count_ - 1U));
   for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(perm_count_ + i);
+}
+
+// ---- wide loop search (beyond the paper; correlative_matcher.h) -----------------------
+
+bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
+                              double box[4]) const {
+  std::uint32_t pi = 0U;
+  if (permanent_slot(level, &pi)) {
+    const Permanent& pm = perm_[pi];
+    *points = perm_obstacles(pi);
+    *count = pm.obstacle_count;
+    *frame = pm.frame_in_global;
+    for (int i = 0; i < 4; ++i) box[i] = pm.box[i];
+    return true;
+  }
+  const std::uint32_t first = graph_.first_live_level();
+  if (level < first || level >= first + graph_.live_level_count()) return false;
+  const std::uint32_t node = choice(best_top_, level);
+  const Submap& sm = submap(level, node);
+  if (!sm.skeleton_done) return false;
+  *points = live_obstacles(level, node);
+  *count = sm.obstacle_count;
+  *frame = frames_[level - first];
+  for (int i = 0; i < 4; ++i) box[i] = sm.box[i];
+  return true;
+}
+
+// A search in progress continues; else the next candidate of the level being searched
+// starts, else the next level's candidates are collected (levels in order, each once,
+// as soon as its skeletons exist).
+void SdpSlam::loop_search_step() {
+  if (matcher_.active()) {
+    loop_search_continue();
+    return;
+  }
+  if (search_cursor_ >= search_count_) {
+    const std::uint32_t first = graph_.first_live_level();
+    if (search_level_ < first) search_level_ = first;
+    if (search_level_ >= graph_.level_end()) return;
+    search_newer_ = search_level_++;
+    loop_search_collect(search_newer_);
+    if (search_count_ == 0U) return;
+  }
+  loop_search_pair(search_older_[search_cursor_++], search_newer_);
+}
+
+// Older levels (permanent or live, not adjacent, not already constrained to it) whose
+// boxes in the best combination overlap the newer's box grown by the search window;
+// the loop_search_candidates largest overlaps.
+void SdpSlam::loop_search_collect(std::uint32_t newer) {
+  search_count_ = 0U;
+  search_cursor_ = 0U;
+  const CellPoint* pts = nullptr;
+  std::uint32_t n = 0U;
+  Pose2 frame;
+  double box[4];
+  if (!level_obstacles(newer, &pts, &n, &frame, box) || n < options_.loop_min_pairs || !box_valid(box)) return;
+  double nb[4];
+  box_transform(frame, box, nb);
+  const double w = options_.loop_search_window_m;
+  nb[0] -= w;
+  nb[1] -= w;
+  nb[2] += w;
+  nb[3] += w;
+  double area[SdpOptions::kMaxLoopSearchCandidates];
+  const std::uint32_t kmax = options_.loop_search_candidates;
+  auto consider = [&](std::uint32_t older) {
+    const CellPoint* op = nullptr;
+    std::uint32_t on = 0U;
+    Pose2 of;
+    double ob[4];
+    if (!level_obstacles(older, &op, &on, &of, ob) || on < options_.loop_min_pairs || !box_valid(ob)) return;
+    for (std::uint32_t k = 0; k < loop_count_; ++k) {
+      if (loops_[k].older_level == older && loops_[k].newer_level == newer) return;
+    }
+    double gb[4];
+    box_transform(of, ob, gb);
+    const double a = box_overlap_m2(gb, nb);
+    if (a < options_.min_overlap_m2 || !(a > 0.0)) return;
+    std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
+    if (pos == kmax && !(a > area[kmax - 1U])) return;
+    if (pos == kmax) pos = kmax - 1U;
+    while (pos > 0U && area[pos - 1U] < a) {
+      area[pos] = area[pos - 1U];
+      search_older_[pos] = search_older_[pos - 1U];
+      --pos;
+    }
+    area[pos] = a;
+    search_older_[pos] = older;
+    if (search_count_ < kmax) ++search_count_;
+  };
+  for (std::uint32_t k = 0; k < perm_count_; ++k) {
+    const std::uint32_t lv = perm_[(perm_head_ + k) % options_.max_permanent_submaps].level;
+    if (lv + 2U <= newer) consider(lv);
+  }
+  for (std::uint32_t lv = graph_.first_live_level(); lv + 2U <= newer; ++lv) consider(lv);
+}
+
+void SdpSlam::loop_search_pair(std::uint32_t older, std::uint32_t newer) {
+  const CellPoint* tp = nullptr;
+  const CellPoint* sp = nullptr;
+  std::uint32_t tn = 0U;
+  std::uint32_t sn = 0U;
+  Pose2 tframe;
+  Pose2 sframe;
+  double tb[4];
+  double sb[4];
+  // Either level may have become permanent (or been forgotten) since it was collected.
+  if (!level_obstacles(older, &tp, &tn, &tframe, tb) || !level_obstacles(newer, &sp, &sn, &sframe, sb)) return;
+  ++stats_.loop_searches;
+  unpack(tp, tn, search_a_);
+  unpack(sp, sn, search_b_);
+  search_pair_older_ = older;
+  search_pair_newer_ = newer;
+  search_a_count_ = tn;
+  search_b_count_ = sn;
+  CorrelativeOptions co;
+  co.resolution_m = search_resolution_m(bottom_options_, options_);
+  co.coarse_cells = kSearchCoarseCells;
+  co.kernel_sigma_m = 1.5 * co.resolution_m;
+  co.window_xy_m = options_.loop_search_window_m;
+  co.window_theta_rad = options_.loop_search_window_rad;
+  co.min_score = options_.loop_search_min_score;
+  co.max_ambiguity = options_.loop_search_max_ambiguity;
+  if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
+    ++stats_.loop_search_failed;
+    return;
+  }
+  loop_search_continue();
+}
+
+// The coarse pass within the per-scan budget; the fine pass, ICP and the verdict when
+// it is complete.
+void SdpSlam::loop_search_continue() {
+  const std::uint64_t cost = matcher_.heading_cost();
+  std::uint64_t h = cost > 0U ? options_.loop_search_reads_per_scan / cost : 1U;
+  if (h < 1U) h = 1U;
+  if (h > 0xFFFFFFFFULL) h = 0xFFFFFFFFULL;
+  if (!matcher_.advance(static_cast<std::uint32_t>(h))) return;
+  const CorrelativeResult c = matcher_.finish();
+  if (c.status == CorrelativeResult::Status::kWeak) {
+    ++stats_.loop_search_weak;
+    return;
+  }
+  if (c.status == CorrelativeResult::Status::kAmbiguous) {
+    ++stats_.loop_search_ambiguous;
+    return;
+  }
+  if (!c.found()) {
+    ++stats_.loop_search_failed;
+    return;
+  }
+  Icp2dOptions fine = options_.icp;
+  fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
+  fine.min_pairs = options_.loop_min_pairs;
+  const Icp2dResult f = icp_->match(search_a_, search_a_count_, search_b_, search_b_count_, c.transform, fine);
+  ++stats_.loop_refinements;
+  // ICP only polishes the peak: it must stay within a coarse block of it.
+  const Pose2 polish = between(c.transform, f.transform);
+  const double reach = static_cast<double>(kSearchCoarseCells) * search_resolution_m(bottom_options_, options_);
+  if (!f.usable() || f.mean_nn_error_m > options_.loop_max_error_m || f.matched_pairs < options_.loop_min_pairs ||
+      polish.x_m * polish.x_m + polish.y_m * polish.y_m > reach * reach) {
+    ++stats_.loop_search_refuted;
+    return;
+  }
+  ++stats_.loop_search_closed;
+  LoopRecord lr;
+  lr.older_level = search_pair_older_;
+  lr.newer_level = search_pair_newer_;
+  lr.z = f.transform;
+  lr.error_m = f.mean_nn_error_m;
+  lr.searched = true;
+  record_loop(lr);
+  if (!loop_record_dead(lr)) update_best();  // the frames follow the new constraint now
 }
 
 }  // namespace sdpslam

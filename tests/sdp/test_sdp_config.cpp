@@ -41,6 +41,13 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   DOUBLES_EQUAL(d.loop_robust_chi, o.loop_robust_chi, 0.0);
   LONGS_EQUAL(d.max_loop_constraints, o.max_loop_constraints);
   LONGS_EQUAL(d.graph_iterations, o.graph_iterations);
+  DOUBLES_EQUAL(d.loop_search_window_m, o.loop_search_window_m, 0.0);
+  DOUBLES_EQUAL(d.loop_search_window_rad, o.loop_search_window_rad, 0.0);
+  DOUBLES_EQUAL(d.loop_search_min_score, o.loop_search_min_score, 0.0);
+  DOUBLES_EQUAL(d.loop_search_max_ambiguity, o.loop_search_max_ambiguity, 0.0);
+  LONGS_EQUAL(d.loop_search_candidates, o.loop_search_candidates);
+  DOUBLES_EQUAL(d.loop_search_robust_chi, o.loop_search_robust_chi, 0.0);
+  LONGS_EQUAL(d.loop_search_reads_per_scan, o.loop_search_reads_per_scan);
   // ... and the bottom-level loader skips the [sdp] section.
   slam::SlamConfig c;
   CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
@@ -89,6 +96,15 @@ TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
   CHECK(slam::apply_sdp_key(&o, "loop_sigma_xy_m", "0", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "graph_iterations", "0", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "max_loop_constraints", "2000000", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_search_window_m", "6", &why) == slam::SdpKeyResult::kApplied);
+  DOUBLES_EQUAL(6.0, o.loop_search_window_m, 0.0);
+  CHECK(slam::apply_sdp_key(&o, "loop_search_window_m", "25", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK_TRUE_TEXT(why.find("loop_search_window_m") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "loop_search_min_score", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_search_candidates", "33", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_search_reads_per_scan", "100", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_search_robust_chi", "12.5", &why) == slam::SdpKeyResult::kApplied);
+  DOUBLES_EQUAL(12.5, o.loop_search_robust_chi, 0.0);
 }
 
 TEST(SdpConfig, enumerated_keys_take_their_names) {

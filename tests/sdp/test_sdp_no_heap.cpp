@@ -74,6 +74,7 @@ void run_without_heap(const SdpOptions& options) {
     CHECK(rig.slam->stats().frame_adjustments > 0U);
     CHECK(sink.frames > rig.slam->stats().levels_made_permanent);  // frames moved
   }
+  if (options.loop_search_window_m > 0.0) CHECK(rig.slam->stats().loop_searches > 0U);
 }
 }  // namespace
 
@@ -83,5 +84,13 @@ TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) { run_
 TEST(SdpNoHeap, loop_closure_allocates_nothing_after_init) {
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
+  run_without_heap(s);
+}
+
+// Wide loop search: the correlative matcher's grids and its searches.
+TEST(SdpNoHeap, wide_loop_search_allocates_nothing_after_init) {
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  s.loop_search_window_m = 3.0;
   run_without_heap(s);
 }

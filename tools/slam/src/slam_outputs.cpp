@@ -216,7 +216,10 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         u(st.loop_records) + ", \"refinements\": " + u(st.loop_refinements) + ", \"added\": " + u(st.loop_records_added) + ", \"dropped\": " +
         u(st.loop_records_dropped) + ", \"used_last\": " + u(st.loop_constraints_used) + ", \"downweighted_last\": " +
         u(st.loop_downweighted) + ", \"adjustments\": " + u(st.frame_adjustments) + ", \"graph_refused\": " +
-        u(st.frame_graph_refused) + "},\n";
+        u(st.frame_graph_refused) + ", \"search\": {\"window_m\": " + fmt("%.3f", so.loop_search_window_m) +
+        ", \"pairs\": " + u(st.loop_searches) + ", \"weak\": " + u(st.loop_search_weak) + ", \"ambiguous\": " +
+        u(st.loop_search_ambiguous) + ", \"failed\": " + u(st.loop_search_failed) + ", \"refuted\": " +
+        u(st.loop_search_refuted) + ", \"closed\": " + u(st.loop_search_closed) + "}},\n";
   js += "  \"pools\": {\n";
   js += filter_pools_json(bottom);
   js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +

@@ -108,6 +108,29 @@ struct SdpOptions {
   double loop_robust_chi = 3.0;
   std::uint32_t max_loop_constraints = 1024U;  // 1 .. capacity::kMaxLoopConstraints
   std::uint32_t graph_iterations = 5U;         // Gauss-Newton steps per adjustment, 1 .. 50
+  // [sdp] wide loop search, beyond the paper (correlative_matcher.h; needs
+  // loop_closure). The constraints above come from the top level's ICP, which only
+  // converges when the chain already placed the two submaps within a few decimetres;
+  // after a long loop it is metres off. So once per level, the best combination's
+  // submap is searched against up to loop_search_candidates older, non-adjacent
+  // submaps whose boxes, grown by loop_search_window_m, overlap its own: exhaustively
+  // within ±loop_search_window_m and ±loop_search_window_rad on their obstacle points;
+  // an unambiguous peak (mean likelihood >= loop_search_min_score, no distinct peak
+  // reaching loop_search_max_ambiguity × it) refined by obstacle ICP with the
+  // loop_max_error_m / loop_min_pairs tests becomes a loop constraint. 0 = off.
+  double loop_search_window_m = 0.0;           // [0, 20]
+  double loop_search_window_rad = 0.35;        // [0, pi]
+  double loop_search_min_score = 0.45;         // (0, 1]
+  double loop_search_max_ambiguity = 0.9;      // (0, 1]
+  std::uint32_t loop_search_candidates = 4U;   // 1 .. kMaxLoopSearchCandidates
+  // Cauchy scale on the constraints the search found (loop_robust_chi is for the top
+  // level's): they passed the ambiguity test, and after a long loop they must be
+  // allowed to pull the chain by metres, far beyond loop_sigma_xy_m × loop_robust_chi.
+  double loop_search_robust_chi = 30.0;        // [1e-3, 1e3]
+  // Grid reads of the search per process() call (about 1 ns each): a search is spread
+  // over as many calls as it needs, whole headings at a time (at least one per call).
+  std::uint32_t loop_search_reads_per_scan = 3000000U;  // [10000, 1e9]
+  static constexpr std::uint32_t kMaxLoopSearchCandidates = 32U;
 
   SdpOptions() {
     icp.max_iterations = 15U;

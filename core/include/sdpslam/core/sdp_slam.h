@@ -69,6 +69,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/correlative_matcher.h"
 #include "sdpslam/core/frame_graph.h"
 #include "sdpslam/core/free_space_skeleton.h"
 #include "sdpslam/core/icp2d.h"
@@ -112,6 +113,12 @@ struct SdpStats {
   std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
+  std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
+  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored too low
+  std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
+  std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
+  std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
+  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
   std::uint32_t max_live_levels = 0U;
@@ -240,6 +247,7 @@ class SdpSlam {
     std::uint32_t newer_level = 0U;
     Pose2 z;
     double error_m = 0.0;
+    bool searched = false;  // found by the wide loop search (else by the top level's ICP)
   };
   // Memo of ICP results: many samples share a pair of submaps placed identically (elite
   // copies, common chains), and ICP is deterministic, so the same inputs give the same
@@ -322,6 +330,15 @@ class SdpSlam {
   bool loop_record_dead(const LoopRecord& r) const;
   void record_loop(const LoopRecord& r);
   void adjust_frames();
+  // Wide loop search (loop_search_window_m > 0): one pair of submaps per call.
+  void loop_search_step();
+  void loop_search_collect(std::uint32_t newer_level);
+  void loop_search_pair(std::uint32_t older_level, std::uint32_t newer_level);
+  void loop_search_continue();
+  // Obstacle points and global frame of a level in the best combination (permanent or
+  // live); false if the level is no longer held.
+  bool level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
+                       double box[4]) const;
 
   SdpOptions options_{};
   DpSlamOptions bottom_options_{};
@@ -371,6 +388,18 @@ class SdpSlam {
   Point2* obst_b_ = nullptr;
   std::uint32_t loop_count_ = 0U;
   FrameGraph frame_graph_;
+  CorrelativeMatcher matcher_;
+  std::uint32_t search_level_ = 0U;     // next level whose submap is searched for loops
+  std::uint32_t search_newer_ = 0U;     // level being searched
+  std::uint32_t search_older_[SdpOptions::kMaxLoopSearchCandidates] = {};
+  std::uint32_t search_count_ = 0U;
+  std::uint32_t search_cursor_ = 0U;
+  Point2* search_a_ = nullptr;  // loop_points: the pair being searched (older, newer)
+  Point2* search_b_ = nullptr;
+  std::uint32_t search_a_count_ = 0U;
+  std::uint32_t search_b_count_ = 0U;
+  std::uint32_t search_pair_older_ = 0U;
+  std::uint32_t search_pair_newer_ = 0U;
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N
