@@ -541,9 +541,6 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   }
   while (transfer_.next_row < r.height && used < budget_cells) {
     std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / r.width);
-    // Within the budget (a strip of a whole patch could take a scan period alone).
-    const std::uint32_t afford = (budget_cells - used) / r.width;
-    if (rows > afford) rows = afford;
     if (rows == 0U) rows = 1U;
     if (rows > r.height - transfer_.next_row) rows = r.height - transfer_.next_row;
     CellRect strip = r;
