@@ -586,19 +586,35 @@ std::uint32_t SdpSlam::release_one() {
 
 std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
   std::uint32_t used = release_one();
-  // Skeletons of the live levels, oldest first.
+  // Skeletons of the live levels, oldest first, in slices.
+  if (skeleton_job_.active) used += skeleton_work(budget_cells - used);
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
     for (std::uint32_t k = 0; k < levels_[slot(lv)].count && used < budget_cells; ++k) {
-      if (!submap(lv, k).skeleton_done) used += extract_skeleton(lv, k);
+      if (submap(lv, k).skeleton_done) continue;
+      start_skeleton(lv, k);
+      used += skeleton_work(budget_cells - used);
     }
   }
   if (used < budget_cells && transfer_.active) used += transfer_rows(budget_cells - used);
   return used;
 }
 
+// A submap's skeleton in slices: its patch is read from the DP map a strip of coarse
+// rows at a time (reading a cell costs microseconds: the cell's observation list is
+// searched for the submap's lineage), within the per-scan budget; the skeleton itself
+// is extracted once the whole patch is classified. One job at a time (coarse_ holds it).
 std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node) {
+  if (!skeleton_job_.active || skeleton_job_.level != level || skeleton_job_.node != node) {
+    while (skeleton_job_.active) skeleton_work(0xFFFFFFFFU);
+    start_skeleton(level, node);
+  }
+  std::uint32_t used = 0U;
+  while (skeleton_job_.active) used += skeleton_work(0xFFFFFFFFU);
+  return used;
+}
+
+void SdpSlam::start_skeleton(std::uint32_t level, std::uint32_t node) {
   Submap& sm = submap(level, node);
-  sm.skeleton_done = true;
   sm.point_count = 0U;
   sm.obstacle_count = 0U;
   box_init(sm.box);
@@ -614,31 +630,73 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
     r.iy0 += static_cast<std::int32_t>((r.height - max_fine) / 2U);
     r.height = max_fine;
   }
-  if (r.width == 0U || r.height == 0U) return 1U;
+  skeleton_job_ = SkeletonJob{};
+  skeleton_job_.level = level;
+  skeleton_job_.node = node;
+  skeleton_job_.rect = r;
+  skeleton_job_.coarse_width = (r.width + d - 1U) / d;
+  skeleton_job_.coarse_height = (r.height + d - 1U) / d;
+  skeleton_job_.active = true;
+}
+
+std::uint32_t SdpSlam::skeleton_work(std::uint32_t budget_cells) {
+  SkeletonJob& job = skeleton_job_;
+  if (!job.active) return 0U;
+  Submap& sm = submap(job.level, job.node);
+  const CellRect& r = job.rect;
+  const std::uint32_t d = options_.skeleton_downsample;
+  const std::uint32_t cw = job.coarse_width;
+  const std::uint32_t ch = job.coarse_height;
   const DpMap& map = filter_->map();
-  map.fill_rect(sm.node, r, fine_values_, fine_known_);
-  const std::uint32_t cw = (r.width + d - 1U) / d;
-  const std::uint32_t ch = (r.height + d - 1U) / d;
-  for (std::uint32_t cy = 0; cy < ch; ++cy) {
-    for (std::uint32_t cx = 0; cx < cw; ++cx) {
-      bool occ = false;
-      bool fre = false;
-      for (std::uint32_t dy = 0; dy < d; ++dy) {
-        const std::uint32_t y = cy * d + dy;
-        if (y >= r.height) break;
-        for (std::uint32_t dx = 0; dx < d; ++dx) {
-          const std::uint32_t x = cx * d + dx;
-          if (x >= r.width) break;
-          const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
-          if (fine_known_[i] == 0U) continue;
-          const double p = filter_->occupancy(fine_values_[i]);
-          if (p >= options_.occupied_threshold) occ = true;
-          else if (p <= options_.free_threshold) fre = true;
-        }
-      }
-      coarse_[static_cast<std::size_t>(cy) * cw + cx] = occ ? CellState::kOccupied : (fre ? CellState::kFree : CellState::kUnknown);
-    }
+  std::uint32_t used = 0U;
+  if (r.width == 0U || r.height == 0U) {
+    job.next_coarse_row = ch;
+    used = 1U;
   }
+  while (job.next_coarse_row < ch && used < budget_cells) {
+    // Whole coarse rows, as many as the budget and the fine buffer afford (at least one).
+    const std::uint32_t row_cells = r.width * d;
+    std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / row_cells);
+    const std::uint32_t afford = (budget_cells - used) / row_cells;
+    if (rows > afford) rows = afford;
+    if (rows == 0U) rows = 1U;
+    if (rows > ch - job.next_coarse_row) rows = ch - job.next_coarse_row;
+    CellRect strip = r;
+    const std::uint32_t fy0 = job.next_coarse_row * d;
+    std::uint32_t fh = rows * d;
+    if (fy0 + fh > r.height) fh = r.height - fy0;
+    strip.iy0 = r.iy0 + static_cast<std::int32_t>(fy0);
+    strip.height = fh;
+    map.fill_rect(sm.node, strip, fine_values_, fine_known_);
+    for (std::uint32_t cy = job.next_coarse_row; cy < job.next_coarse_row + rows; ++cy) {
+      for (std::uint32_t cx = 0; cx < cw; ++cx) {
+        bool occ = false;
+        bool fre = false;
+        for (std::uint32_t dy = 0; dy < d; ++dy) {
+          const std::uint32_t y = cy * d + dy;
+          if (y >= r.height) break;
+          for (std::uint32_t dx = 0; dx < d; ++dx) {
+            const std::uint32_t x = cx * d + dx;
+            if (x >= r.width) break;
+            const std::size_t i = static_cast<std::size_t>(y - fy0) * r.width + x;
+            if (fine_known_[i] == 0U) continue;
+            const double p = filter_->occupancy(fine_values_[i]);
+            if (p >= options_.occupied_threshold) occ = true;
+            else if (p <= options_.free_threshold) fre = true;
+          }
+        }
+        coarse_[static_cast<std::size_t>(cy) * cw + cx] =
+            occ ? CellState::kOccupied : (fre ? CellState::kFree : CellState::kUnknown);
+      }
+    }
+    job.next_coarse_row += rows;
+    used += r.width * fh;
+  }
+  if (job.next_coarse_row < ch) return used;
+  // The whole patch is classified: the skeleton (and the obstacle points).
+  job.active = false;
+  sm.skeleton_done = true;
+  if (r.width == 0U || r.height == 0U) return used;
   GridPatchView patch;
   patch.width = cw;
   patch.height = ch;
@@ -649,8 +707,8 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
   SkeletonOptions so;
   so.min_clearance_m = options_.skeleton_min_clearance_m;
   so.max_points = options_.skeleton_points;
-  Point2* out = live_points(level, node);
-  if (options_.loop_closure) extract_obstacles(sm, live_obstacles(level, node), r, cw, ch);
+  Point2* out = live_points(job.level, job.node);
+  if (options_.loop_closure) extract_obstacles(sm, live_obstacles(job.level, job.node), r, cw, ch);
   const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
   ++stats_.skeletons;
   if (res.status == SkeletonResult::Status::kOk) {
@@ -658,7 +716,7 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
     stats_.skeleton_truncated_points += res.truncated_count;
     for (std::uint32_t i = 0; i < sm.point_count; ++i) box_add(sm.box, out[i].x_m, out[i].y_m);
   }
-  return r.width * r.height;
+  return used;
 }
 
 // ---- top level (lines 10-12) -----------------------------------------------------------

@@ -217,6 +217,35 @@ TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
   CHECK_TRUE(b.slam->graph().invariants_hold());
 }
 
+// Worst-scan time: a skeleton patch is read from the DP map in strips of coarse rows
+// within the per-scan budget (reading a cell costs microseconds), not in one go.
+TEST(SdpSlam, skeleton_work_per_scan_stays_within_the_budget) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  s.work_cells_per_scan = 4096U;
+  s.max_levels = capacity::kMaxPgsLevels;  // no level becomes permanent: no map transfer
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 21));
+  std::uint32_t most = 0U;
+  std::uint64_t skeleton_scans = 0U;
+  for (std::size_t i = 0; i < set.scans.size(); ++i) {
+    const SdpStepResult r = rig.slam->process(set.odom(i), *set.scans[i]);
+    if (r.work_cells <= 1U) continue;  // idle (or one submap released)
+    ++skeleton_scans;
+    if (r.work_cells > most) most = r.work_cells;
+  }
+  rig.slam->finish();
+  LONGS_EQUAL(0, rig.slam->stats().levels_made_permanent);
+  CHECK(skeleton_scans > 50U);
+  CHECK(rig.slam->stats().skeletons > 20U);
+  // Budget, plus the last strip started within it (one coarse row: 2 fine rows of a
+  // patch at most 16 m = 320 cells wide), plus the release of one submap.
+  CHECK(most <= s.work_cells_per_scan + 2U * 322U + 1U);
+  std::printf("\n  skeletons: %llu in %llu scans, at most %u cells per scan (budget %u)\n",
+              static_cast<unsigned long long>(rig.slam->stats().skeletons), static_cast<unsigned long long>(skeleton_scans),
+              most, s.work_cells_per_scan);
+}
+
 TEST(SdpSlam, same_seed_gives_bit_identical_trajectories) {
   const test::ScanSet set(2);
   test::SdpRig a;

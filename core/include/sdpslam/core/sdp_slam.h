@@ -56,11 +56,21 @@
 // anchor move with it, so later samples are placed from the corrected frames; the
 // permanent path sink is told every new frame, so the trajectory follows. The global
 // map's permanent part keeps the frames its submaps had when they were copied into it.
+// Wide loop search (SdpOptions::loop_search_window_m > 0): ICP only sees loops the chain
+// already closed to within decimetres, so once per level the chosen submap is also
+// searched against the older submaps it may revisit, over metres and tenths of a
+// radian (correlative_matcher.h); an unambiguous peak that obstacle ICP confirms becomes
+// a constraint behind its own, wider kernel, and the frames are adjusted at once. The
+// search runs in slices (loop_search_reads_per_scan grid reads per call of process()).
 //
-// Worst-scan time: anchorage work (skeleton extraction, map transfer) is done in chunks
-// of at most work_cells_per_scan map cells per call of process(), and top-level samples
-// are evaluated evaluations_per_scan per call, so the work of a segmentation is spread
-// over the following scans. All counts, no clocks: the output is deterministic.
+// Worst-scan time: anchorage work is spread over calls of process(): skeleton patches
+// are read from the DP map in strips of coarse rows within work_cells_per_scan cells
+// (plus at most one row), the copy of a permanent submap into the global map in strips
+// of up to a skeleton patch while work_cells_per_scan is not used up (not cut finer:
+// the submap's observations are freed only when its copy is complete, and where the
+// pool is tight holding them longer costs the bottom level its map updates), and
+// top-level samples are evaluated evaluations_per_scan per call. All counts, no clocks:
+// the output is deterministic.
 //
 // Memory: init() carves everything from the caller's Arena (required_arena_bytes());
 // process() never touches the heap. The object is large (ICP tables, bottom filter):
@@ -260,6 +270,16 @@ class SdpSlam {
     bool valid = false;
   };
   static constexpr std::uint32_t kIcpMemoSlots = 1024U;
+  // A skeleton being read from the DP map a strip of coarse rows at a time.
+  struct SkeletonJob {
+    bool active = false;
+    std::uint32_t level = 0U;
+    std::uint32_t node = 0U;
+    CellRect rect{};  // the patch (fine cells)
+    std::uint32_t coarse_width = 0U;
+    std::uint32_t coarse_height = 0U;
+    std::uint32_t next_coarse_row = 0U;
+  };
   struct Transfer {
     bool active = false;
     NodeId node = kNoNode;
@@ -313,7 +333,10 @@ class SdpSlam {
   void segment(std::int64_t stamp_us);
   void make_oldest_permanent();
   std::uint32_t do_work(std::uint32_t budget_cells);
+  // The whole skeleton now (completing any other job first); returns cells read.
   std::uint32_t extract_skeleton(std::uint32_t level, std::uint32_t node);
+  void start_skeleton(std::uint32_t level, std::uint32_t node);
+  std::uint32_t skeleton_work(std::uint32_t budget_cells);  // the job, within the budget
   std::uint32_t transfer_rows(std::uint32_t budget_cells);
   std::uint32_t release_one();
   void rank_particles();
@@ -405,6 +428,7 @@ class SdpSlam {
   NodeId* release_queue_ = nullptr;  // N
   std::uint32_t release_count_ = 0U;
   Transfer transfer_{};
+  SkeletonJob skeleton_job_{};
   NodeId global_node_ = kNoNode;
 
   // Current segment.
