@@ -71,12 +71,14 @@ TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line
   CHECK_TRUE_TEXT(error.find("topology") != std::string::npos, error.c_str());
 }
 
-TEST(SdpConfig, shipped_best_configuration_turns_on_scan_matching_and_loop_closure) {
+TEST(SdpConfig, shipped_best_configuration_turns_on_scan_matching_loop_closure_and_search) {
   const std::string best = std::string(SDPSLAM_DEFAULT_INI).substr(0, std::string(SDPSLAM_DEFAULT_INI).rfind('/')) + "/best.ini";
   SdpOptions o;
   std::string error;
   CHECK_TRUE_TEXT(slam::load_sdp_ini(best, &o, &error), error.c_str());
   CHECK_TRUE(o.loop_closure);
+  CHECK(o.loop_search_window_m > 0.0);
+  LONGS_EQUAL(8, o.max_levels);
   slam::SlamConfig c;
   CHECK_TRUE_TEXT(slam::load_config_ini(best, &c, &error), error.c_str());
   CHECK(c.filter.proposal == DpSlamOptions::Proposal::kScanMatch);
