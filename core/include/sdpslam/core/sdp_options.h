@@ -94,8 +94,8 @@ struct SdpOptions {
   // loop_robust_chi). false (the default) = the paper's top level only. It pays off
   // where the bottom level drifts little between loops: with [proposal] kind =
   // scan_match Intel's relations error is 0.07, 0.12 and 0.50 m for seeds 1, 2 and 3;
-  // with the wide search below as well (tools/slam/best.ini) it is 0.062-0.123 m over
-  // seeds 1-5 (mean 0.094), and ACES's 0.073-0.089 m (mean 0.083).
+  // with the wide search below as well (tools/slam/best.ini) it is 0.060-0.113 m over
+  // seeds 1-5 (mean 0.077), and ACES's 0.067-0.104 m (mean 0.080).
   bool loop_closure = false;
   std::uint32_t loop_points = 300U;  // obstacle points per submap, 16 .. capacity::kMaxIcpPoints
   double loop_icp_max_correspondence_m = 0.3;
@@ -125,8 +125,12 @@ struct SdpOptions {
   double loop_search_max_ambiguity = 0.9;      // (0, 1]
   std::uint32_t loop_search_candidates = 4U;   // 1 .. kMaxLoopSearchCandidates
   // Cauchy scale on the constraints the search found (loop_robust_chi is for the top
-  // level's): they passed the ambiguity test, and after a long loop they must be
-  // allowed to pull the chain by metres, far beyond loop_sigma_xy_m × loop_robust_chi.
+  // level's), for two submaps 10 levels apart; it grows with the square root of the
+  // levels between them (SdpSlam::loop_search_chi: the chain drifts like a random walk).
+  // After a long loop they must be allowed to pull the chain by metres, far beyond
+  // loop_sigma_xy_m × loop_robust_chi; a false match between nearby submaps must not.
+  // On Intel (seeds 1-5) a constant 30 left two seeds at 0.11-0.12 m and a constant 10
+  // or 20 failed to close ACES's first loop on seed 2.
   double loop_search_robust_chi = 30.0;        // [1e-3, 1e3]
   // Grid reads of the search per process() call (about 1 ns each): a search is spread
   // over as many calls as it needs, whole headings at a time (at least one per call).
