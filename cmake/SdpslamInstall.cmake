@@ -119,9 +119,6 @@ endif()
 if(TARGET sdpslam AND EXISTS "${PROJECT_SOURCE_DIR}/tools/slam/default.ini")
   install(FILES "${PROJECT_SOURCE_DIR}/tools/slam/default.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
     RENAME sdpslam-run.ini COMPONENT runtime)
-  # The most accurate configuration measured (scan-matching proposals + loop closure).
-  install(FILES "${PROJECT_SOURCE_DIR}/tools/slam/best.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
-    RENAME sdpslam-best.ini COMPONENT runtime)
 endif()
 
 # ---- Debian packages ------------------------------------------------------------------

@@ -287,6 +287,13 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       }
       return R::kOk;
     }
+    if (key == "profile") {
+      if (!parse_sdp_profile(v, &c.profile)) {
+        *why = "'" + std::string(v) + "' is not a profile (accurate, paper)";
+        return R::kBad;
+      }
+      return R::kOk;
+    }
     if (key == "seed") {
       if (*v == '-' || !int_in(v, 0, 0x7FFFFFFFFFFFFFFFLL, &i, why)) {
         if (why->empty()) *why = std::string(v) + " is not a non-negative integer";
@@ -365,6 +372,20 @@ int handler(void* user, const char* section, const char* name, const char* value
   return 0;
 }
 
+// First pass: [slam] mode and profile only (the last of each wins, as in the full pass;
+// malformed values are left to it), so that the profile is applied before any key.
+int profile_handler(void* user, const char* section, const char* name, const char* value) {
+  auto* c = static_cast<DaemonConfig*>(user);
+  if (name == nullptr || std::strcmp(section, "slam") != 0) return 1;
+  if (std::strcmp(name, "mode") == 0) {
+    if (std::strcmp(value, "sdp") == 0) c->mode = SlamMode::kSdp;
+    if (std::strcmp(value, "dpslam") == 0) c->mode = SlamMode::kDpSlam;
+  } else if (std::strcmp(name, "profile") == 0) {
+    (void)parse_sdp_profile(value, &c->profile);
+  }
+  return 1;
+}
+
 }  // namespace
 
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
@@ -373,6 +394,11 @@ bool load_daemon_config(const std::string& path, DaemonConfig* config, std::stri
     *error = path + ": cannot open: " + std::strerror(errno);
     return false;
   }
+  // The [slam] profile (sdp mode) is where the options start: the file's keys go on top of
+  // it wherever they appear in the file.
+  (void)ini_parse_file(f, profile_handler, config);
+  if (config->mode == SlamMode::kSdp) apply_profile(config->profile, &config->slam.filter, &config->sdp);
+  std::rewind(f);
   ParseState st{config, path, {}, f, 0};
   const int rc = ini_parse_stream(read_line, &st, handler, &st);
   std::fclose(f);

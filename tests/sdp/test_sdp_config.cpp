@@ -4,6 +4,7 @@
 #include <fstream>
 #include <string>
 
+#include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/config_ini.h"
 #include "sdpslam/slam/run_sdp.h"
 #include "shared_data.h"
@@ -15,7 +16,6 @@ TEST_GROUP(SdpConfig){};
 TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaults) {
   SdpOptions o;
   o.top_particles = 7U;  // the file must set it back
-  o.max_levels = 3U;
   std::string error;
   CHECK_TRUE_TEXT(slam::load_sdp_ini(SDPSLAM_DEFAULT_INI, &o, &error), error.c_str());
   const SdpOptions d;
@@ -53,6 +53,21 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
 }
 
+TEST(SdpConfig, shipped_default_file_leaves_the_profile_keys_to_the_profile) {
+  // default.ini can be used as it is on top of either profile.
+  slam::SlamConfig c;
+  SdpOptions o;
+  apply_profile(SdpProfile::kAccurate, &c.filter, &o);
+  std::string error;
+  CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
+  CHECK_TRUE_TEXT(slam::load_sdp_ini(SDPSLAM_DEFAULT_INI, &o, &error), error.c_str());
+  CHECK(c.filter.proposal == DpSlamOptions::Proposal::kScanMatch);
+  LONGS_EQUAL(8, c.filter.match.beam_stride);
+  LONGS_EQUAL(8, o.max_levels);
+  CHECK_TRUE(o.loop_closure);
+  DOUBLES_EQUAL(6.0, o.loop_search_window_m, 0.0);
+}
+
 TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line) {
   const std::string dir = sdpslam::test::make_temp_dir("sdp_config");
   const std::string path = dir + "/c.ini";
@@ -71,18 +86,44 @@ TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line
   CHECK_TRUE_TEXT(error.find("topology") != std::string::npos, error.c_str());
 }
 
-TEST(SdpConfig, shipped_best_configuration_turns_on_scan_matching_loop_closure_and_search) {
-  const std::string best = std::string(SDPSLAM_DEFAULT_INI).substr(0, std::string(SDPSLAM_DEFAULT_INI).rfind('/')) + "/best.ini";
+TEST(SdpConfig, accurate_profile_turns_on_scan_matching_loop_closure_and_search) {
+  DpSlamOptions b;
   SdpOptions o;
-  std::string error;
-  CHECK_TRUE_TEXT(slam::load_sdp_ini(best, &o, &error), error.c_str());
+  apply_profile(SdpProfile::kAccurate, &b, &o);
   CHECK_TRUE(o.loop_closure);
   CHECK(o.loop_search_window_m > 0.0);
   LONGS_EQUAL(8, o.max_levels);
-  slam::SlamConfig c;
-  CHECK_TRUE_TEXT(slam::load_config_ini(best, &c, &error), error.c_str());
-  CHECK(c.filter.proposal == DpSlamOptions::Proposal::kScanMatch);
-  LONGS_EQUAL(8, c.filter.match.beam_stride);
+  CHECK(b.proposal == DpSlamOptions::Proposal::kScanMatch);
+  LONGS_EQUAL(8, b.match.beam_stride);
+  char why[200];
+  CHECK_TRUE_TEXT(b.validate(why, sizeof why), why);
+  CHECK_TRUE_TEXT(o.validate(why, sizeof why), why);
+  CHECK(kDefaultSdpProfile == SdpProfile::kAccurate);
+}
+
+TEST(SdpConfig, paper_profile_is_the_declared_defaults_and_changes_nothing) {
+  DpSlamOptions b;
+  SdpOptions o;
+  b.match.beam_stride = 5U;  // a value set before the profile stays
+  apply_profile(SdpProfile::kPaper, &b, &o);
+  CHECK(b.proposal == DpSlamOptions::Proposal::kOdometry);
+  LONGS_EQUAL(5, b.match.beam_stride);
+  CHECK_FALSE(o.loop_closure);
+  DOUBLES_EQUAL(0.0, o.loop_search_window_m, 0.0);
+  LONGS_EQUAL(12, o.max_levels);
+}
+
+TEST(SdpConfig, profile_names_parse_and_print_both_ways) {
+  SdpProfile p = SdpProfile::kPaper;
+  CHECK_TRUE(parse_sdp_profile("accurate", &p));
+  CHECK(p == SdpProfile::kAccurate);
+  STRCMP_EQUAL("accurate", to_string(p));
+  CHECK_TRUE(parse_sdp_profile("paper", &p));
+  STRCMP_EQUAL("paper", to_string(p));
+  CHECK_FALSE(parse_sdp_profile("best", &p));
+  CHECK_FALSE(parse_sdp_profile("", &p));
+  CHECK_FALSE(parse_sdp_profile(nullptr, &p));
+  CHECK(p == SdpProfile::kPaper);
 }
 
 TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {

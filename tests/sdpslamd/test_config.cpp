@@ -51,6 +51,53 @@ TEST(SdpslamdConfig, shipped_example_config_loads_with_documented_defaults) {
   LONGS_EQUAL(5000000, c.output_period_us);
 }
 
+TEST(SdpslamdConfig, shipped_example_starts_sdp_from_the_accurate_profile) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &c, &error), error.c_str());
+  CHECK(c.profile == sdpslam::SdpProfile::kAccurate);
+  CHECK(c.slam.filter.proposal == sdpslam::DpSlamOptions::Proposal::kScanMatch);
+  LONGS_EQUAL(8, c.slam.filter.match.beam_stride);
+  CHECK_TRUE(c.sdp.loop_closure);
+  DOUBLES_EQUAL(6.0, c.sdp.loop_search_window_m, 0.0);
+  LONGS_EQUAL(8, c.sdp.max_levels);
+}
+
+TEST(SdpslamdConfig, profile_applies_before_every_key_wherever_it_stands) {
+  // The profile comes last in the file, yet the keys before it win over it.
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[sdp]\nmax_levels = 5\n[proposal]\nbeam_stride = 3\n"
+                                               "[slam]\nmode = sdp\nprofile = accurate\n"),
+                                     &c, &error),
+                  error.c_str());
+  LONGS_EQUAL(5, c.sdp.max_levels);
+  LONGS_EQUAL(3, c.slam.filter.match.beam_stride);
+  CHECK_TRUE(c.sdp.loop_closure);  // from the profile
+  CHECK(c.slam.filter.proposal == sdpslam::DpSlamOptions::Proposal::kScanMatch);
+}
+
+TEST(SdpslamdConfig, paper_profile_keeps_the_papers_algorithm) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[slam]\nprofile = paper\n"), &c, &error), error.c_str());
+  CHECK(c.slam.filter.proposal == sdpslam::DpSlamOptions::Proposal::kOdometry);
+  CHECK_FALSE(c.sdp.loop_closure);
+  LONGS_EQUAL(12, c.sdp.max_levels);
+}
+
+TEST(SdpslamdConfig, dpslam_mode_does_not_take_the_profile) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[slam]\nprofile = accurate\nmode = dpslam\n"), &c, &error),
+                  error.c_str());
+  CHECK(c.slam.filter.proposal == sdpslam::DpSlamOptions::Proposal::kOdometry);
+}
+
+TEST(SdpslamdConfig, unknown_profile_is_rejected_with_its_line) {
+  expect_rejected("[slam]\nmode = sdp\nprofile = best\n", 3, "slam.profile: 'best' is not a profile (accurate, paper)");
+}
+
 TEST(SdpslamdConfig, values_are_applied_to_every_part) {
   DaemonConfig c;
   std::string error;
@@ -161,6 +208,7 @@ TEST(SdpslamdConfig, offline_default_ini_loads_as_daemon_config_with_the_offline
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
   sdpslam::SdpOptions offline;
+  sdpslam::apply_profile(sdpslam::kDefaultSdpProfile, nullptr, &offline);  // as `sdpslam run` does
   offline.top_particles = 1U;  // differs from the file, so the comparison sees the file was read
   CHECK_TRUE_TEXT(sdpslam::slam::load_sdp_ini(SDPSLAM_DEFAULT_INI, &offline, &error), error.c_str());
   LONGS_EQUAL(offline.top_particles, c.sdp.top_particles);

@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
               sk_total_us / sk_reps, sk_min_us, sk_cpu_us, sk_reps, s.ridge_cell_count, s.point_count, arena.used_bytes());
   // Wide loop search: walls of a 20 m × 12 m floor (rooms off a corridor) thinned to
   // 300 points, as a submap's obstacle points are; the source is the same walls moved
-  // by (2.3 m, -1.7 m, 0.15 rad). Grid side 318 cells of 0.1 m, as in best.ini.
+  // by (2.3 m, -1.7 m, 0.15 rad). Grid side 318 cells of 0.1 m, as in the accurate profile.
   {
     using sdpslam::test::add_segment;
     std::size_t n = 0U;

@@ -1,13 +1,14 @@
 #!/bin/sh
-# SDP-SLAM benchmark: Intel and ACES with ONE option set (tools/slam/default.ini unless
-# CONFIG is given) at the paper's 60T/10B unless TB says otherwise: relations error
+# SDP-SLAM benchmark: Intel and ACES with ONE option set (the default profile, accurate,
+# with tools/slam/default.ini on top unless PROFILE / CONFIG say otherwise) at the
+# paper's 60T/10B unless TB says otherwise: relations error
 # through `sdpslam evaluate`, per-scan time (median, p99, max), the fixed arena declared
 # at init, pool high-water marks and peak RSS from each run's stats.json.
 #
 #   tools/bench/bench_sdp.sh BUILD_DIR [OUT_DIR]
 #   e.g. tools/bench/bench_sdp.sh build/release /tmp/sdp-bench
 #
-# Environment: CONFIG=file.ini, SEED (default 1), SHARED (default ../shared beside the
+# Environment: PROFILE (accurate or paper), CONFIG=file.ini, SEED (default 1), SHARED (default ../shared beside the
 # checkout), LOGS (default "intel aces"), TB (default "60/10": top/bottom particles,
 # several allowed: "60/10 30/5"), TOPOLOGY (sdp or segslam, default sdp).
 set -eu
@@ -16,6 +17,7 @@ root=$(cd "$here/../.." && pwd)
 build=${1:?usage: bench_sdp.sh BUILD_DIR [OUT_DIR]}
 out=${2:-/tmp/sdpslam-sdp-bench}
 config=${CONFIG:-$root/tools/slam/default.ini}
+profile=${PROFILE:-accurate}
 seed=${SEED:-1}
 shared=${SHARED:-$root/../shared}
 logs=${LOGS:-"intel aces"}
@@ -34,7 +36,7 @@ for log in $logs; do
     dir="$out/$log-${t}T${b}B"
     echo "== $log, ${t}T/${b}B ($topology) -> $dir" >&2
     "$bin" run "$shared/datasets/$log.clf" --mode sdp --topology "$topology" --top-particles "$t" --particles "$b" \
-      --config "$config" --seed "$seed" --out "$dir"
+      --profile "$profile" --config "$config" --seed "$seed" --out "$dir"
     eval_json="$dir/evaluate.json"
     if "$bin" evaluate --log "$shared/datasets/$log.clf" --relations "$shared/datasets/$log.relations" \
          --trajectory "$dir/trajectory.txt" --json "$eval_json" > "$dir/evaluate.txt" 2>&1; then

@@ -14,7 +14,9 @@
 #   e.g. tools/bench/compare_paper.sh build/release /tmp/sdpslam-paper
 #
 # Environment: SEED (default 1), SHARED (default ../shared beside the checkout),
-# DATASETS (default "sim intel"), CONFIG (INI for every run, default tools/slam/default.ini).
+# DATASETS (default "sim intel"), CONFIG (INI for every run, default tools/slam/default.ini),
+# PROFILE (sdp runs' --profile, default paper: the paper's algorithm, as in its Table I;
+# accurate adds scan-matching proposals and loop closure to both topologies).
 # Use a Release build; the Intel part takes a while.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
@@ -25,6 +27,7 @@ seed=${SEED:-1}
 shared=${SHARED:-$root/../shared}
 datasets=${DATASETS:-"sim intel"}
 config=${CONFIG:-$root/tools/slam/default.ini}
+profile=${PROFILE:-paper}
 bin="$build/tools/cli/sdpslam"
 [ -x "$bin" ] || { echo "compare_paper.sh: no sdpslam binary in $build" >&2; exit 2; }
 mkdir -p "$out"
@@ -73,8 +76,8 @@ for ds in $datasets; do
     for topo in segslam sdp; do
       dir="$out/$ds-$topo-${t}T${b}B"
       echo "== $ds $topo ${t}T/${b}B -> $dir" >&2
-      "$bin" run "$log" --mode sdp --topology "$topo" --top-particles "$t" --particles "$b" --config "$config" \
-        --seed "$seed" --out "$dir" > "$dir.log" 2>&1 || true
+      "$bin" run "$log" --mode sdp --topology "$topo" --top-particles "$t" --particles "$b" --profile "$profile" \
+        --config "$config" --seed "$seed" --out "$dir" > "$dir.log" 2>&1 || true
       s="$dir/stats.json"
       if [ -f "$s" ]; then
         set -- $(icp "$s")

@@ -1,14 +1,17 @@
 // `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
-//               [--topology sdp|segslam] [--config FILE.ini] [--seed S] --out DIR`
+//               [--topology sdp|segslam] [--profile accurate|paper] [--config FILE.ini]
+//               [--seed S] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
-// (tools/slam/run_sdp.h); dpslam: the bottom-level DP-SLAM filter alone, the baseline
-// (tools/slam/run_offline.h).
+// (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
+// accurate by default, or the paper's algorithm) with the --config file's keys on top;
+// dpslam: the bottom-level DP-SLAM filter alone, the baseline (tools/slam/run_offline.h).
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "cli_common.h"
 #include "sdpslam/slam/run_offline.h"
+#include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/run_sdp.h"
 
 namespace sdpslam::cli {
@@ -20,6 +23,7 @@ struct RunArgs {
   std::uint32_t particles = 0U;      // 0 = dpslam: from the config; sdp: 10
   std::uint32_t top_particles = 0U;  // 0 = from the sdp config (60)
   std::string topology;
+  std::string profile;               // empty = kDefaultSdpProfile
   std::string config;
   std::uint64_t seed = 1U;
   std::string out;
@@ -32,10 +36,13 @@ int report(const char* what, int code, const std::string& error) {
   return code;
 }
 
-int run_sdp_mode(const RunArgs& a, slam::SlamConfig config) {
+// `config` holds the profile's bottom-level options with the file's keys on top.
+int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, SdpProfile profile) {
   slam::SdpRunOptions ro;
   ro.config = config;
+  ro.profile = profile;
   std::string error;
+  apply_profile(profile, nullptr, &ro.sdp);
   if (!a.config.empty() && !slam::load_sdp_ini(a.config, &ro.sdp, &error)) {
     return report("", kExitBadInput, error);
   }
@@ -103,16 +110,28 @@ std::function<int()> setup_run(CLI::App& app) {
   app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)");
   app.add_option("--topology", args->topology, "sdp: topology estimation, sdp (default) or segslam (local analysis)")
       ->check(CLI::IsMember({"sdp", "segslam"}));
-  app.add_option("--config", args->config, "INI options: bottom level and [sdp] (see tools/slam/default.ini)");
+  app.add_option("--profile", args->profile,
+                 "sdp: options to start from before --config: accurate (default: scan-matching proposals, loop "
+                 "closure and wide loop search) or paper (the paper's algorithm); core/sdp_profile.h")
+      ->check(CLI::IsMember({"accurate", "paper"}));
+  app.add_option("--config", args->config,
+                 "INI options on top of the profile: bottom level and [sdp] (see tools/slam/default.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)");
   app.add_option("--out", args->out, "Output directory")->required();
   return [args]() -> int {
+    const bool sdp = args->mode != "dpslam";
+    if (!sdp && !args->profile.empty()) {
+      return report("", kExitUsage, "--profile applies to --mode sdp (dpslam starts from tools/slam/default.ini)");
+    }
+    SdpProfile profile = kDefaultSdpProfile;
+    if (!args->profile.empty()) (void)parse_sdp_profile(args->profile.c_str(), &profile);  // checked by CLI11
     slam::SlamConfig config;
+    if (sdp) apply_profile(profile, &config.filter, nullptr);
     std::string error;
     if (!args->config.empty() && !slam::load_config_ini(args->config, &config, &error)) {
       return report("", kExitBadInput, error);
     }
-    return args->mode == "dpslam" ? run_dpslam_mode(*args, config) : run_sdp_mode(*args, config);
+    return sdp ? run_sdp_mode(*args, config, profile) : run_dpslam_mode(*args, config);
   };
 }
 

@@ -348,7 +348,12 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   const SdpOptions& so = options.sdp;
   std::string js = "{\n";
   js += "  \"log\": \"" + log_path + "\",\n";
-  js += "  \"mode\": \"sdp\",\n  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
+  js += "  \"mode\": \"sdp\",\n  \"profile\": \"" + std::string(to_string(options.profile)) + "\",\n";
+  js += "  \"proposal\": \"" +
+        std::string(fo.proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry") +
+        "\",\n  \"loop_closure\": " + (so.loop_closure ? "true" : "false") + ",\n  \"loop_search_window_m\": " +
+        fmt("%g", so.loop_search_window_m) + ",\n  \"max_levels\": " + u(so.max_levels) + ",\n";
+  js += "  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
         "\",\n";
   js += "  \"top_particles\": " + u(so.top_particles) + ",\n  \"bottom_particles\": " + u(fo.particle_count) +
         ",\n  \"seed\": " + u(options.seed) + ",\n";

@@ -6,7 +6,8 @@
 //   [laser]   serial device, protocol (scip | sick), line speed, timeouts, mounting pose
 //   [robot]   differential-drive geometry (drivers::DiffDriveParams)
 //   [sync]    odometry-to-scan alignment: wait bound, largest gap interpolated, queue
-//   [slam]    mode (dpslam | sdp) and seed; the filter's own sections [filter] [motion]
+//   [slam]    mode (dpslam | sdp), profile (sdp mode's starting options, applied before
+//             every other key wherever it stands) and seed; the filter's own sections [filter] [motion]
 //             [observation] [proposal] [map] [capacity] [log] are the offline runner's
 //             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
 //   [sdp]     SDP-SLAM's segmentation and top level (mode = sdp), the offline runner's
@@ -22,6 +23,7 @@
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/drivers/can_wheel_encoders.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/drivers/sick_lms2xx_laser.h"
@@ -58,6 +60,10 @@ struct DaemonConfig {
   // SDP-SLAM, the project's algorithm (the offline runner's default too): with the example's
   // options its arena is smaller than dpslam's (sdpslamd.ini [slam] gives the figures).
   SlamMode mode = SlamMode::kSdp;
+  // Where sdp mode's options start (core/sdp_profile.h), as `sdpslam run --profile`:
+  // load_daemon_config applies it before the file's keys (accurate: scan-matching
+  // proposals and loop closure; paper: the paper's algorithm).
+  SdpProfile profile = kDefaultSdpProfile;
   std::uint64_t seed = 1U;
   slam::SlamConfig slam;
   // [sdp]

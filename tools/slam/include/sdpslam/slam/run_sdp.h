@@ -22,6 +22,7 @@
 #include <string>
 
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/config_ini.h"
 
 namespace sdpslam::slam {
@@ -29,6 +30,9 @@ namespace sdpslam::slam {
 struct SdpRunOptions {
   SlamConfig config;      // bottom level ([filter] particles = B) and log options
   SdpOptions sdp;         // [sdp]
+  // The profile config and sdp started from (core/sdp_profile.h): reported in stats.json
+  // only; the caller applies it before the file's keys.
+  SdpProfile profile = kDefaultSdpProfile;
   std::uint64_t seed = 1U;
   bool progress = false;
 };
