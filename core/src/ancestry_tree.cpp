@@ -32,6 +32,7 @@ bool AncestryTree::init(Arena& arena, std::uint32_t node_capacity, std::uint32_t
   last_root_ = kNoNode;
   active_count_ = 0U;
   label_counter_ = 0U;
+  tree_counter_ = 0U;
   pruned_ = false;
   return true;
 }
@@ -78,6 +79,7 @@ NodeId AncestryTree::create_root() {
   l.post = l.pre;
   l.depth = 0U;
   l.anchor = id;
+  l.tree = ++tree_counter_;
   return id;
 }
 
@@ -93,6 +95,7 @@ NodeId AncestryTree::add_child(NodeId parent) {
   l.post = 0U;
   l.depth = labels_[parent].depth + 1U;
   l.anchor = labels_[parent].anchor;
+  l.tree = labels_[parent].tree;
   return id;
 }
 
@@ -355,7 +358,7 @@ bool AncestryTree::invariants_hold() const {
         if (!contains(c) || node(c).parent != x || node(c).prev_sibling != prev) return false;
         if (++kids > capacity_) return false;
         const Label& lc = labels_[c];
-        if (lc.depth != l.depth + 1U) return false;
+        if (lc.depth != l.depth + 1U || lc.tree != l.tree) return false;
         if (lc.anchor == c) {
           if (l.anchor != x || !(l.pre < lc.pre && lc.post < l.post)) return false;
           if (prev != kNoNode && labels_[prev].anchor == prev && !(labels_[prev].post < lc.pre)) return false;

@@ -144,11 +144,21 @@ std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_
   const std::uint32_t location = (slot << (2U * kSideLog2)) | c;
   // Entries of live nodes only (invariant), so the unchecked query is safe.
   const AncestryTree::DescendantQuery query(*tree_, particle);
+  // Cell lists hold newer trees' entries before older trees' (invariants_hold), and only
+  // the particle's own tree can hold its ancestors: newer trees' entries are skipped, and
+  // the first older tree's entry ends the search. In SDP-SLAM every segment is a tree, so
+  // a revisited cell's entries of earlier segments are not walked by the current one.
+  const std::uint32_t own_tree = tree_->tree_sequence_unchecked(particle);
   NodeId up = particle;  // next ancestor-or-self whose index entry is probed
   for (;;) {
     const Observation& o = obs_[e];
     const NodeId node = owner_node_[o.owner];
-    if (node == particle || query.has_ancestor_or_self(node)) return e;
+    const std::uint32_t entry_tree = tree_->tree_sequence_unchecked(node);
+    if (entry_tree == own_tree) {
+      if (node == particle || query.has_ancestor_or_self(node)) return e;
+    } else if (entry_tree < own_tree) {
+      return kNone;
+    }
     e = o.next_in_cell;
     if (e == kNone) return kNone;  // the list is exhausted: no ancestor-or-self here
     if (index_ == nullptr) continue;  // no index: the scan alone decides
@@ -266,13 +276,23 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
   o->owner = owner;
   o->value = value;
   o->location = (slot << (2U * kSideLog2)) | c;
-  // Keep descendants before ancestors: a leaf goes first; an inner node goes after the
-  // last entry of any of its descendants.
+  // Keep newer trees' entries before older trees' and, within a tree, descendants before
+  // ancestors: a leaf goes after the entries of newer trees (first, unless it belongs to
+  // an older tree, as SdpSlam's global-map root does); an inner node goes after the last
+  // entry of any of its descendants. A tree's entries are contiguous, so the walk ends at
+  // the first entry of an older tree.
   std::uint32_t prev = kNone;
-  if (tree_->child_count(particle) > 0U) {
-    for (std::uint32_t f = tile.head[c]; f != kNone; f = obs_[f].next_in_cell) {
-      if (tree_->is_ancestor_or_self(particle, owner_node_[obs_[f].owner])) prev = f;
+  const std::uint32_t own_tree = tree_->tree_sequence_unchecked(particle);
+  const bool inner = tree_->child_count(particle) > 0U;
+  for (std::uint32_t f = tile.head[c]; f != kNone; f = obs_[f].next_in_cell) {
+    const NodeId node = owner_node_[obs_[f].owner];
+    const std::uint32_t entry_tree = tree_->tree_sequence_unchecked(node);
+    if (entry_tree > own_tree) {
+      prev = f;
+      continue;
     }
+    if (entry_tree < own_tree || !inner) break;
+    if (tree_->is_ancestor_or_self(particle, node)) prev = f;
   }
   const std::uint32_t next = prev == kNone ? tile.head[c] : obs_[prev].next_in_cell;
   o->prev_in_cell = prev;
@@ -503,6 +523,8 @@ bool DpMap::invariants_hold() const {
         for (std::uint32_t f = o.next_in_cell; f != kNone; f = obs_[f].next_in_cell) {
           if (obs_[f].owner == o.owner) return false;
           if (tree_->is_ancestor_or_self(node, owner_node_[obs_[f].owner])) return false;  // order
+          // newer trees first (find_view stops at the first older tree's entry)
+          if (tree_->tree_sequence(owner_node_[obs_[f].owner]) > tree_->tree_sequence(node)) return false;
         }
       }
     }

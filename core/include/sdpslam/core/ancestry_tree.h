@@ -81,6 +81,7 @@ class AncestryTree {
     std::uint32_t post = 0U;
     std::uint32_t depth = 0U;
     NodeId anchor = kNoNode;
+    std::uint32_t tree = 0U;  // tree_sequence(): create_root() order of the node's tree
   };
  public:
   AncestryTree() = default;
@@ -132,6 +133,14 @@ class AncestryTree {
   std::uint32_t child_count(NodeId node) const;       // 0 for a dead id
   // Edges from the node's root; exact after prune, parent's + 1 for a node added since.
   std::uint32_t depth(NodeId node) const { return contains(node) ? labels_[node].depth : 0U; }
+  // Which tree of the forest `node` belongs to: 1 for the first create_root(), one more
+  // for each later root; a child inherits its parent's, and prune keeps it (removals and
+  // merges stay inside one tree). Newer trees have larger numbers, so DpMap can order
+  // its cell lists by tree. 0 for a dead id. Wraps after 2^32 roots (not reachable:
+  // one root per segment).
+  std::uint32_t tree_sequence(NodeId node) const { return contains(node) ? labels_[node].tree : 0U; }
+  // The same without the liveness check, for callers that hold live ids (DpMap).
+  std::uint32_t tree_sequence_unchecked(NodeId node) const { return labels_[node].tree; }
 
   // True iff `ancestor` is `descendant` or one of its ancestors. O(1) (two interval
   // comparisons on DFS pre/post numbers) whenever `ancestor` existed at the last prune;
@@ -262,6 +271,7 @@ class AncestryTree {
   NodeId last_root_ = kNoNode;
   std::uint32_t active_count_ = 0U;
   std::uint32_t label_counter_ = 0U;  // next free DFS number (new roots take fresh ones)
+  std::uint32_t tree_counter_ = 0U;   // create_root() calls: the newest tree's sequence
   std::uint32_t node_oom_count_ = 0U;
   std::uint32_t path_oom_count_ = 0U;
   std::uint32_t misuse_count_ = 0U;

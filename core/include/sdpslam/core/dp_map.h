@@ -216,8 +216,8 @@ class DpMap final : public TreeListener {
   // its list is non-empty, its count equals its list's length, and the free stack holds
   // exactly the other owners; every observation is in exactly one cell list and one
   // owner list, and they agree on its owner and cell; no node has two
-  // observations in one cell and no entry follows an entry of one of its ancestors
-  // (what lets lookups stop early); the backward cell links mirror the forward ones; the
+  // observations in one cell, no entry follows an entry of one of its ancestors, and no
+  // entry follows one of an older tree of the forest (what lets lookups stop early); the backward cell links mirror the forward ones; the
   // index holds exactly the observations, each findable by its (owner, cell) key;
   // every node with observations is live in the tree; the
   // tile table and tile back-references agree; each tile's count equals its entries
