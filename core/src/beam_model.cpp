@@ -131,6 +131,21 @@ double BeamModel::log_likelihood(const DpMap& map, NodeId particle, const ScanRa
 
 double BeamModel::log_likelihood_strided(const DpMap& map, NodeId particle, const ScanRays& rays,
                                          const Pose2& robot, std::uint32_t stride, BeamScore* score) const {
+  return likelihood(map, rays, robot, stride, score,
+                    [&](std::int32_t ix, std::int32_t iy, CellObservation* obs) {
+                      return map.lookup(particle, ix, iy, obs);
+                    });
+}
+
+double BeamModel::log_likelihood_strided(ViewCache& view, const DpMap& map, const ScanRays& rays,
+                                         const Pose2& robot, std::uint32_t stride, BeamScore* score) const {
+  return likelihood(map, rays, robot, stride, score,
+                    [&](std::int32_t ix, std::int32_t iy, CellObservation* obs) { return view.lookup(ix, iy, obs); });
+}
+
+template <class Lookup>
+double BeamModel::likelihood(const DpMap& map, const ScanRays& rays, const Pose2& robot, std::uint32_t stride,
+                             BeamScore* score, Lookup&& lookup) const {
   if (stride == 0U) stride = 1U;
   std::uint32_t beams = 0U;
   std::uint32_t known_beams = 0U;
@@ -160,7 +175,7 @@ double BeamModel::log_likelihood_strided(const DpMap& map, NodeId particle, cons
     double like = 0.0;
     trace_cells(x0, y0, x1, y1, [&](std::int32_t ix, std::int32_t iy, bool) {
       CellObservation obs;
-      const bool seen = map.lookup(particle, ix, iy, &obs);
+      const bool seen = lookup(ix, iy, &obs);
       known = known || seen;
       const double p = seen ? stop_probability(obs) : unknown;
       // Distance along the beam of the cell centre's projection.

@@ -44,7 +44,9 @@ std::size_t DpSlamFilter::required_arena_bytes(const DpSlamOptions& o) {
   const std::uint32_t n = o.particle_count;
   return AncestryTree::required_arena_bytes(o.node_capacity(), o.path_entry_capacity()) + map_bytes +
          2U * array_bytes<Particle>(n) + array_bytes<Pose2>(n) + 2U * array_bytes<double>(n) +
-         2U * array_bytes<std::uint32_t>(n) + kSlack;
+         2U * array_bytes<std::uint32_t>(n) + kSlack +
+         (o.proposal == DpSlamOptions::Proposal::kScanMatch ? ViewCache::required_arena_bytes(capacity::kViewCacheSlots)
+                                                            : 0U);
 }
 
 bool DpSlamFilter::init(const DpSlamOptions& options, Arena& arena, std::uint64_t seed) {
@@ -85,6 +87,11 @@ bool DpSlamFilter::init(const DpSlamOptions& options, Arena& arena, std::uint64_
   if (particles_ == nullptr || next_ == nullptr || proposed_ == nullptr || log_w_ == nullptr || w_ == nullptr ||
       drawn_ == nullptr || counts_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving particle arrays");
+    return false;
+  }
+  view_ = ViewCache{};
+  if (options.proposal == DpSlamOptions::Proposal::kScanMatch && !view_.init(arena, capacity::kViewCacheSlots)) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the scan matcher's view cache");
     return false;
   }
   particle_count_ = n;
@@ -233,7 +240,7 @@ double DpSlamFilter::propose(std::uint32_t i, const Pose2& delta) {
   if (options_.proposal == DpSlamOptions::Proposal::kScanMatch) {
     // Improved proposal (Grisetti et al. 2007, §IV): match from the odometry prediction.
     const Pose2 predicted = p.pose.compose(delta);
-    const ScanMatch m = match_scan(beam_, map_, p.node, rays_, predicted, options_.match);
+    const ScanMatch m = match_scan(beam_, map_, p.node, rays_, predicted, options_.match, &view_);
     stats_.proposal_evaluations += m.evaluations;
     switch (m.outcome) {
       case ScanMatch::Outcome::kMatched: {

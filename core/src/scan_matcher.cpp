@@ -29,12 +29,18 @@ struct LogSumExp {
 }  // namespace
 
 ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, const ScanRays& rays,
-                     const Pose2& initial, const ScanMatcherOptions& options) {
+                     const Pose2& initial, const ScanMatcherOptions& options, ViewCache* view) {
+  if (view != nullptr && view->ready()) view->begin(map, particle);
+  else view = nullptr;
+  const std::uint32_t stride = options.beam_stride == 0U ? 1U : options.beam_stride;
+  auto score_at = [&](const Pose2& pose, BeamScore* score) {
+    return view != nullptr ? model.log_likelihood_strided(*view, map, rays, pose, stride, score)
+                           : model.log_likelihood_strided(map, particle, rays, pose, stride, score);
+  };
   ScanMatch m;
   m.pose = initial;
-  const std::uint32_t stride = options.beam_stride == 0U ? 1U : options.beam_stride;
   BeamScore score;
-  double best = model.log_likelihood_strided(map, particle, rays, initial, stride, &score);
+  double best = score_at(initial, &score);
   m.evaluations = 1U;
   m.beams = score.beams;
   m.log_likelihood = best;
@@ -63,7 +69,7 @@ ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, 
       double step_score = best;
       for (const Pose2& mv : moves) {
         const Pose2 cand = pose.compose(mv);
-        const double s = model.log_likelihood_strided(map, particle, rays, cand, stride, nullptr);
+        const double s = score_at(cand, nullptr);
         ++m.evaluations;
         if (finest) last_level.add(s);
         if (s > step_score) {

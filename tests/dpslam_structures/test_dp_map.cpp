@@ -9,6 +9,7 @@
 
 #include "dp_fixture.h"
 #include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/view_cache.h"
 
 using sdpslam::CellObservation;
 using sdpslam::DpMap;
@@ -378,4 +379,66 @@ TEST(DpMap, extraction_matches_lookup_and_touched_bounds_cover_written_tiles) {
 TEST(DpMap, footprint_reports_the_fixed_storage) {
   DpFixture f(8U, 8U, small_options(4U, 100U));
   CHECK(f.map.footprint_bytes() >= 100U * 20U + 4U * 1024U + 9U * 4U);
+}
+
+TEST(DpMap, views_stay_exact_across_a_forest_when_an_older_tree_is_written_after_newer_ones) {
+  // SDP-SLAM's case: every segment is a new tree, and the global map's root (an older
+  // tree) keeps being written. Lookups skip newer trees and stop at older ones.
+  DpFixture f(16U, 16U, small_options(9U, 64U));
+  const NodeId r1 = f.tree.create_root();
+  const NodeId a1 = f.tree.add_child(r1);
+  const NodeId b1 = f.tree.add_child(r1);
+  CHECK_TRUE(f.map.update(r1, 5, 5, obs(1, 0)));
+  const NodeId r2 = f.tree.create_root();
+  CHECK_TRUE(f.map.update(r2, 5, 5, obs(2, 0)));
+  const NodeId c2 = f.tree.add_child(r2);
+  const NodeId d2 = f.tree.add_child(r2);
+  CHECK_TRUE(f.map.update(c2, 5, 5, obs(3, 0)));
+  CHECK_TRUE(f.map.update(a1, 5, 5, obs(4, 0)));   // older tree, written last
+  CHECK_TRUE(f.map.add(b1, 5, 5, 0U, 2U));         // its view (r1's) plus two misses
+  const NodeId r3 = f.tree.create_root();
+  LONGS_EQUAL(1, f.tree.tree_sequence(a1));
+  LONGS_EQUAL(2, f.tree.tree_sequence(d2));
+  LONGS_EQUAL(3, f.tree.tree_sequence(r3));
+  CHECK_TRUE(view_is(f.map, c2, 5, 5, obs(3, 0)));
+  CHECK_TRUE(view_is(f.map, d2, 5, 5, obs(2, 0)));
+  CHECK_TRUE(view_is(f.map, a1, 5, 5, obs(4, 0)));
+  CHECK_TRUE(view_is(f.map, b1, 5, 5, obs(1, 2)));
+  CHECK_TRUE(view_is(f.map, r1, 5, 5, obs(1, 0)));
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(r3, 5, 5, &v));
+  CHECK_TRUE(f.map.invariants_hold());
+  CHECK_TRUE(f.tree.invariants_hold());
+}
+
+TEST(DpMap, view_cache_answers_exactly_what_the_map_answers) {
+  DpFixture f(16U, 16U, small_options(9U, 64U));
+  const NodeId root = f.tree.create_root();
+  for (std::int32_t i = 0; i < 6; ++i) CHECK_TRUE(f.map.update(root, i, 2, obs(static_cast<std::uint16_t>(i), 1)));
+  const NodeId a = f.tree.add_child(root);
+  const NodeId b = f.tree.add_child(root);
+  CHECK_TRUE(f.map.update(a, 3, 2, obs(9, 9)));
+  std::vector<unsigned char> buf(sdpslam::ViewCache::required_arena_bytes(16U));
+  sdpslam::Arena arena(buf.data(), buf.size());
+  sdpslam::ViewCache cache;
+  CHECK_FALSE(cache.init(arena, 12U));  // not a power of two
+  CHECK_TRUE(cache.init(arena, 16U));   // holds 12 cells: the rest is read through
+  for (const NodeId p : {a, b, a}) {
+    cache.begin(f.map, p);
+    for (int pass = 0; pass < 2; ++pass) {
+      // 8 x 3 cells, some observed, most not, two outside the map (x = -1).
+      for (std::int32_t iy = 1; iy <= 3; ++iy) {
+        for (std::int32_t ix = -1; ix <= 6; ++ix) {
+          CellObservation want{77U, 77U};
+          CellObservation got{77U, 77U};
+          const bool seen = f.map.lookup(p, ix, iy, &want);
+          CHECK_EQUAL(seen, cache.lookup(ix, iy, &got));
+          CHECK_TRUE(got == want);
+        }
+      }
+    }
+  }
+  // 3 bursts x 2 passes x 24 reads; each burst caches 12 cells, answered in its second pass.
+  LONGS_EQUAL(3 * 2 * 24, cache.hits() + cache.misses());
+  LONGS_EQUAL(3 * 12, cache.hits());
 }

@@ -34,6 +34,7 @@
 #include "sdpslam/core/dp_map.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/range_scan.h"
+#include "sdpslam/core/view_cache.h"
 
 namespace sdpslam {
 
@@ -85,6 +86,10 @@ class BeamModel {
   // bit. Used by the scan matcher of the improved proposal (scan_matcher.h).
   double log_likelihood_strided(const DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
                                 std::uint32_t stride, BeamScore* score) const;
+  // The same through `view` (view.begin(map, particle) called, map unchanged since):
+  // bit-identical, with repeated cells read once.
+  double log_likelihood_strided(ViewCache& view, const DpMap& map, const ScanRays& rays, const Pose2& robot,
+                                std::uint32_t stride, BeamScore* score) const;
 
   // Writes the scan into `particle`'s map. Returns the number of cell updates the map
   // dropped (0 normally).
@@ -96,6 +101,9 @@ class BeamModel {
 
  private:
   double gauss_mass(double abs_error_m) const;
+  template <class Lookup>
+  double likelihood(const DpMap& map, const ScanRays& rays, const Pose2& robot, std::uint32_t stride,
+                    BeamScore* score, Lookup&& lookup) const;
 
   BeamModelOptions options_{};
   double resolution_m_ = 0.05;

@@ -49,6 +49,16 @@ inline constexpr std::uint32_t kDpTileCells = kDpTileSideCells * kDpTileSideCell
 // A DpMap observation addresses its cell as (tile slot << 2k) | cell-in-tile in 32 bits.
 inline constexpr std::uint32_t kDpMaxTiles = 0xFFFFFFFFU >> (2U * kDpTileSideLog2);
 
+#ifndef SDPSLAM_VIEW_CACHE_SLOTS_LOG2
+#define SDPSLAM_VIEW_CACHE_SLOTS_LOG2 14
+#endif
+// Cells one scan match remembers of its particle's view (view_cache.h), 16 bytes each,
+// allocated only with the scan-matching proposal. A hill climb reads ~10^3-10^4 distinct
+// cells; past 3/4 of the slots reads go to the map uncached (same values, slower).
+inline constexpr std::uint32_t kViewCacheSlotsLog2 = SDPSLAM_VIEW_CACHE_SLOTS_LOG2;
+static_assert(kViewCacheSlotsLog2 >= 4U && kViewCacheSlotsLog2 <= 24U, "kViewCacheSlotsLog2 out of range [4,24]");
+inline constexpr std::uint32_t kViewCacheSlots = 1U << kViewCacheSlotsLog2;
+
 }  // namespace sdpslam::capacity
 
 // ---- Top level: ICP matching, free-space skeleton, graph of segments (paper §III) ---

@@ -43,6 +43,7 @@
 #include "sdpslam/core/motion_model.h"
 #include "sdpslam/core/range_scan.h"
 #include "sdpslam/core/rng.h"
+#include "sdpslam/core/view_cache.h"
 
 namespace sdpslam {
 
@@ -159,6 +160,7 @@ class DpSlamFilter {
   AncestryTree tree_;
   DpMap map_;
   BeamModel beam_;
+  ViewCache view_;  // the scan matcher's memory of one particle's view (kScanMatch only)
   MotionModel motion_;
   Rng rng_;
   PoseSink* sink_ = nullptr;

@@ -51,8 +51,9 @@ struct ScanMatch {
 };
 
 // Refines `initial` for `particle`'s map; see the header comment. Options are taken as
-// given (DpSlamOptions::validate() range-checks them).
+// given (DpSlamOptions::validate() range-checks them). `view` (may be null) remembers the
+// cells read (view_cache.h): same result, each distinct cell looked up in the map once.
 ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, const ScanRays& rays,
-                     const Pose2& initial, const ScanMatcherOptions& options);
+                     const Pose2& initial, const ScanMatcherOptions& options, ViewCache* view = nullptr);
 
 }  // namespace sdpslam
