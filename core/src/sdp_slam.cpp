@@ -363,6 +363,15 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
     }
   }
   // Top-level work within the budget: anchorage first (the evaluation needs skeletons).
+  // With defer_top_work it waits while the bottom level processes scans (bounded).
+  if (options_.defer_top_work && result.bottom.status == StepResult::Status::kProcessed &&
+      deferred_in_a_row_ < capacity::kMaxDeferredTopWork) {
+    ++deferred_in_a_row_;
+    ++stats_.top_work_deferred;
+    result.pose = current_frame_.compose(result.bottom.pose);
+    return result;
+  }
+  deferred_in_a_row_ = 0U;
   result.work_cells = do_work(options_.work_cells_per_scan);
   bool work_pending = false;
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && !work_pending; ++lv) {
@@ -545,7 +554,10 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
     transfer_.next_row = r.height;
   }
   while (transfer_.next_row < r.height && used < budget_cells) {
+    // A strip fits the work buffers and what is left of the budget (at least one row).
     std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / r.width);
+    const std::uint32_t budget_rows = (budget_cells - used) / r.width;
+    if (budget_rows < rows) rows = budget_rows;
     if (rows == 0U) rows = 1U;
     if (rows > r.height - transfer_.next_row) rows = r.height - transfer_.next_row;
     CellRect strip = r;
@@ -591,6 +603,11 @@ std::uint32_t SdpSlam::release_one() {
 
 std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
   std::uint32_t used = release_one();
+  // The permanent submap's copy into the global map first, in strips within the budget:
+  // its observations (and the tiles only it holds) are freed when it completes, and the
+  // pool is what the bottom level's new observations come from.
+  if (transfer_.active && used < budget_cells) used += transfer_rows(budget_cells - used);
+  if (used >= budget_cells) return used;
   // Skeletons of the live levels, oldest first, in slices.
   if (skeleton_job_.active) used += skeleton_work(budget_cells - used);
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
@@ -600,7 +617,6 @@ std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
       used += skeleton_work(budget_cells - used);
     }
   }
-  if (used < budget_cells && transfer_.active) used += transfer_rows(budget_cells - used);
   return used;
 }
 

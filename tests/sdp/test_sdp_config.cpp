@@ -48,6 +48,7 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   LONGS_EQUAL(d.loop_search_candidates, o.loop_search_candidates);
   DOUBLES_EQUAL(d.loop_search_robust_chi, o.loop_search_robust_chi, 0.0);
   LONGS_EQUAL(d.loop_search_reads_per_scan, o.loop_search_reads_per_scan);
+  CHECK_EQUAL(d.defer_top_work, o.defer_top_work);
   // ... and the bottom-level loader skips the [sdp] section.
   slam::SlamConfig c;
   CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());

@@ -246,6 +246,55 @@ TEST(SdpSlam, skeleton_work_per_scan_stays_within_the_budget) {
               most, s.work_cells_per_scan);
 }
 
+TEST(SdpSlam, deferred_top_work_waits_for_scans_the_bottom_level_skips_and_is_never_starved) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  s.defer_top_work = true;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 21));
+  std::uint32_t processed_in_a_row = 0U;
+  std::uint64_t processed = 0U;
+  std::uint64_t idle_with_work = 0U;
+  for (std::size_t i = 0; i < set.scans.size(); ++i) {
+    const SdpStepResult r = rig.slam->process(set.odom(i), *set.scans[i]);
+    const bool bottom = r.bottom.status == StepResult::Status::kProcessed;
+    processed_in_a_row = bottom ? processed_in_a_row + 1U : 0U;
+    if (bottom) ++processed;
+    const bool top = r.work_cells > 0U || r.evaluations > 0U;
+    if (!bottom && top) ++idle_with_work;
+    // On a processed scan the top level works only after kMaxDeferredTopWork waits.
+    if (bottom && top) CHECK(processed_in_a_row > capacity::kMaxDeferredTopWork);
+  }
+  rig.slam->finish();
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.top_work_deferred > 0U);
+  CHECK(st.top_work_deferred <= processed);
+  CHECK(idle_with_work > 0U);
+  // The work still gets done: levels, skeletons and evaluations as without deferral.
+  CHECK(st.levels_made_permanent > 0U);
+  CHECK(st.skeletons > 20U);
+  CHECK(st.evaluations > 100U);
+}
+
+TEST(SdpSlam, deferred_top_work_still_runs_when_the_bottom_level_processes_every_scan) {
+  const test::ScanSet set(1);
+  SdpOptions s = test::small_sdp_options();
+  s.defer_top_work = true;
+  DpSlamOptions b = test::sim_options(5);
+  b.update_min_travel_m = 0.0;  // every scan is processed
+  b.update_min_rotation_rad = 0.0;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(b, s, 21));
+  std::uint64_t with_work = 0U;
+  for (std::size_t i = 0; i < set.scans.size(); ++i) {
+    const SdpStepResult r = rig.slam->process(set.odom(i), *set.scans[i]);
+    if (r.work_cells > 0U || r.evaluations > 0U) ++with_work;
+  }
+  CHECK(with_work > 0U);
+  CHECK(rig.slam->stats().skeletons > 0U);
+  CHECK(rig.slam->stats().evaluations > 0U);
+}
+
 TEST(SdpSlam, searched_loops_get_a_kernel_that_grows_with_the_levels_between) {
   DOUBLES_EQUAL(30.0, SdpSlam::loop_search_chi(30.0, 5U, 15U), 1e-12);
   DOUBLES_EQUAL(60.0, SdpSlam::loop_search_chi(30.0, 0U, 40U), 1e-12);

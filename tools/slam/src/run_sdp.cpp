@@ -185,6 +185,11 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "occupied_threshold") ok = real(&t.occupied_threshold);
   else if (key == "free_threshold") ok = real(&t.free_threshold);
   else if (key == "work_cells_per_scan") ok = integer(&t.work_cells_per_scan);
+  else if (key == "defer_top_work") {
+    if (v == "true") t.defer_top_work = true;
+    else if (v == "false") t.defer_top_work = false;
+    else ok = false;
+  }
   else if (key == "map_tile_capacity") ok = integer(&t.map_tile_capacity);
   else if (key == "map_observation_capacity") ok = integer(&t.map_observation_capacity);
   else if (key == "map_owner_cell_index") {
@@ -287,6 +292,11 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   std::vector<double> scan_ms;
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
   double cpu_max_by_kind[4] = {0.0, 0.0, 0.0, 0.0};
+  // Split by whether the bottom filter processed the scan (top-level work alone or not),
+  // and the scans over one 10 Hz scan period.
+  double cpu_max_bottom_processed = 0.0;
+  double cpu_max_bottom_idle = 0.0;
+  std::uint64_t scans_cpu_over_100ms = 0U;
   std::vector<double> segment_ms;
   detail::ScanOdometryPairing pairing;
   OdometrySample od;
@@ -303,6 +313,9 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     // work alone, or the bottom filter alone.
     const int kind = r.segmented != SegmentEnd::kNone ? 0 : (r.evaluations > 0U ? 1 : (r.work_cells > 0U ? 2 : 3));
     cpu_max_by_kind[kind] = std::max(cpu_max_by_kind[kind], cpu);
+    double& split = r.bottom.status == StepResult::Status::kProcessed ? cpu_max_bottom_processed : cpu_max_bottom_idle;
+    split = std::max(split, cpu);
+    if (cpu > 100.0) ++scans_cpu_over_100ms;
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
     scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
     if (options.progress && scans.size() % 200U == 0U) {
@@ -349,10 +362,6 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   std::string js = "{\n";
   js += "  \"log\": \"" + log_path + "\",\n";
   js += "  \"mode\": \"sdp\",\n  \"profile\": \"" + std::string(to_string(options.profile)) + "\",\n";
-  js += "  \"proposal\": \"" +
-        std::string(fo.proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry") +
-        "\",\n  \"loop_closure\": " + (so.loop_closure ? "true" : "false") + ",\n  \"loop_search_window_m\": " +
-        fmt("%g", so.loop_search_window_m) + ",\n  \"max_levels\": " + u(so.max_levels) + ",\n";
   js += "  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
         "\",\n";
   js += "  \"top_particles\": " + u(so.top_particles) + ",\n  \"bottom_particles\": " + u(fo.particle_count) +
@@ -371,7 +380,10 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
         ", \"scan_cpu_ms_max_segmentation\": " + fmt("%.3f", cpu_max_by_kind[0]) +
         ", \"scan_cpu_ms_max_evaluation\": " + fmt("%.3f", cpu_max_by_kind[1]) +
         ", \"scan_cpu_ms_max_anchorage\": " + fmt("%.3f", cpu_max_by_kind[2]) +
-        ", \"scan_cpu_ms_max_bottom_only\": " + fmt("%.3f", cpu_max_by_kind[3]) + ", \"peak_rss_kib\": " +
+        ", \"scan_cpu_ms_max_bottom_only\": " + fmt("%.3f", cpu_max_by_kind[3]) +
+        ", \"scan_cpu_ms_max_bottom_processed\": " + fmt("%.3f", cpu_max_bottom_processed) +
+        ", \"scan_cpu_ms_max_bottom_idle\": " + fmt("%.3f", cpu_max_bottom_idle) +
+        ", \"scans_cpu_over_100ms\": " + u(scans_cpu_over_100ms) + ", \"peak_rss_kib\": " +
         u(static_cast<std::uint64_t>(ru.ru_maxrss)) + "}\n}\n";
   if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return SdpRunStatus::kIoError;
 

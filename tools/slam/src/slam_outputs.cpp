@@ -210,6 +210,7 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
         ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
         ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
+  js += "  \"top_work_deferred\": " + u(st.top_work_deferred) + ",\n";
   js += "  \"bottom_proposal\": \"" +
         std::string(bottom.options().proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry") + "\",\n";
   js += "  \"loop_closure\": {\"enabled\": " + std::string(so.loop_closure ? "true" : "false") + ", \"records\": " +

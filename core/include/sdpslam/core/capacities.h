@@ -95,6 +95,9 @@ static_assert(kMaxSkeletonPatchSide >= 3U && kMaxSkeletonPatchSide <= 8192U, "kM
 // made permanent; nodes per level are bounded by kMaxBottomParticles (one submap each).
 inline constexpr std::uint32_t kMaxPgsLevels = SDPSLAM_MAX_PGS_LEVELS;
 static_assert(kMaxPgsLevels >= 2U && kMaxPgsLevels <= 65536U, "kMaxPgsLevels out of range");
+// SdpOptions::defer_top_work: processed scans in a row after which the top level's work
+// runs anyway (a bottom level processing every scan must not starve it).
+inline constexpr std::uint32_t kMaxDeferredTopWork = 3U;
 inline constexpr std::uint32_t kMaxPgsNodesPerLevel = kMaxBottomParticles;
 
 }  // namespace sdpslam::capacity

@@ -64,6 +64,16 @@ struct SdpOptions {
   double occupied_threshold = 0.6;  // occupancy >= this is an obstacle
   double free_threshold = 0.35;     // occupancy <= this is free
   std::uint32_t work_cells_per_scan = 120000U;  // map cells read per scan by anchorage work
+  // Beyond the paper (per-scan time): true = the top level's work (anchorage, evaluations,
+  // loop search) waits while the bottom level processes scans, so that the two costs do
+  // not add up in one scan; it runs on the scans the bottom level skips (most of them:
+  // it processes a scan per update_min_travel_m), and anyway after
+  // capacity::kMaxDeferredTopWork processed scans in a row, so that it is never starved.
+  // Measured with the accurate profile (seed 1): Intel's worst scan 79-80 ms instead of
+  // 86-106 ms, same relations error; ACES worst 77-115 ms instead of 106-110 ms, but its
+  // submaps are released later, the observation pool runs shorter and the relations
+  // error rises (seeds 1 and 3: 0.101 and 0.122 m instead of 0.081 and 0.068 m). Off.
+  bool defer_top_work = false;
   // [sdp] fixed memory of the shared DP map in SDP mode (0 = keep the [map] values):
   // tiles that may hold data and observations for every live submap and the global map.
   std::uint32_t map_tile_capacity = 8000U;

@@ -64,14 +64,15 @@
 // submaps (loop_search_chi()), and the frames are adjusted at once. The
 // search runs in slices (loop_search_reads_per_scan grid reads per call of process()).
 //
-// Worst-scan time: anchorage work is spread over calls of process(): skeleton patches
-// are read from the DP map in strips of coarse rows within work_cells_per_scan cells
-// (plus at most one row), the copy of a permanent submap into the global map in strips
-// of up to a skeleton patch while work_cells_per_scan is not used up (not cut finer:
-// the submap's observations are freed only when its copy is complete, and where the
-// pool is tight holding them longer costs the bottom level its map updates), and
-// top-level samples are evaluated evaluations_per_scan per call. All counts, no clocks:
-// the output is deterministic.
+// Worst-scan time: anchorage work is spread over calls of process() within
+// work_cells_per_scan cells each (plus at most one row): first the copy of a permanent
+// submap into the global map, in strips of rows (it goes first because the submap's
+// observations are freed only when its copy is complete, and where the pool is tight
+// holding them longer costs the bottom level its map updates), then the skeleton
+// patches, read from the DP map in strips of coarse rows; top-level samples are
+// evaluated evaluations_per_scan per call. With defer_top_work all of it waits while
+// the bottom level processes scans (at most capacity::kMaxDeferredTopWork in a row), so
+// the two costs do not add up. All counts, no clocks: the output is deterministic.
 //
 // Memory: init() carves everything from the caller's Arena (required_arena_bytes());
 // process() never touches the heap. The object is large (ICP tables, bottom filter):
@@ -110,6 +111,7 @@ struct SdpStats {
   std::uint64_t map_transfer_cells = 0U;
   std::uint64_t map_transfer_dropped = 0U;  // global-map cell updates refused (pool full)
   std::uint64_t rounds = 0U;
+  std::uint64_t top_work_deferred = 0U;     // processed scans whose top-level work waited (defer_top_work)
   std::uint64_t rounds_with_overlap = 0U;
   std::uint64_t evaluations = 0U;
   std::uint64_t evaluations_with_overlap = 0U;
@@ -444,6 +446,7 @@ class SdpSlam {
   double seg_box_[4] = {0.0, 0.0, 0.0, 0.0};  // best poses of the current segment
   // Top-level round.
   bool round_active_ = false;
+  std::uint32_t deferred_in_a_row_ = 0U;  // defer_top_work: processed scans without top-level work
   std::uint32_t eval_cursor_ = 0U;
   std::uint32_t rounds_in_segment_ = 0U;
   double round_sum_ = 0.0;
