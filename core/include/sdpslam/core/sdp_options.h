@@ -104,8 +104,8 @@ struct SdpOptions {
   // loop_robust_chi). false (the default) = the paper's top level only. It pays off
   // where the bottom level drifts little between loops: with [proposal] kind =
   // scan_match Intel's relations error is 0.07, 0.12 and 0.50 m for seeds 1, 2 and 3;
-  // with the wide search below as well (profile accurate, sdp_profile.h) it is 0.060-0.113 m over
-  // seeds 1-5 (mean 0.077), and ACES's 0.067-0.104 m (mean 0.080).
+  // with the wide search below as well (profile accurate, sdp_profile.h) it is
+  // 0.060-0.113 m over seeds 1-5 (mean 0.077), and ACES's 0.068-0.088 m (mean 0.080).
   bool loop_closure = false;
   std::uint32_t loop_points = 300U;  // obstacle points per submap, 16 .. capacity::kMaxIcpPoints
   double loop_icp_max_correspondence_m = 0.3;
