@@ -246,6 +246,29 @@ TEST(SdpSlam, skeleton_work_per_scan_stays_within_the_budget) {
               most, s.work_cells_per_scan);
 }
 
+TEST(SdpSlam, map_transfer_is_cut_to_the_per_scan_budget_and_still_completes) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  s.work_cells_per_scan = 4096U;  // a submap's rectangle is several times this
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 21));
+  std::uint32_t most = 0U;
+  for (std::size_t i = 0; i < set.scans.size(); ++i) {
+    const SdpStepResult r = rig.slam->process(set.odom(i), *set.scans[i]);
+    if (r.work_cells > most) most = r.work_cells;
+  }
+  rig.slam->finish();
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.levels_made_permanent > 0U);
+  CHECK(st.map_transfer_cells > 0U);
+  // Every permanent submap but the last was copied and released while scans came in.
+  CHECK(st.submaps_released >= st.levels_made_permanent * 5U - 1U);
+  // Budget, plus the last strip started within it (one row of a transfer or two fine rows
+  // of a skeleton patch, at most 16 m = 320 cells wide), plus the release of one submap.
+  CHECK(most <= s.work_cells_per_scan + 2U * 322U + 1U);
+  CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+}
+
 TEST(SdpSlam, deferred_top_work_waits_for_scans_the_bottom_level_skips_and_is_never_starved) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
