@@ -19,6 +19,13 @@ const char* to_string(SlamMode m) { return m == SlamMode::kDpSlam ? "dpslam" : "
 
 namespace {
 
+bool parse_mode(const char* text, SlamMode* mode) {
+  if (std::strcmp(text, "sdp") == 0) *mode = SlamMode::kSdp;
+  else if (std::strcmp(text, "dpslam") == 0) *mode = SlamMode::kDpSlam;
+  else return false;
+  return true;
+}
+
 struct ParseState {
   DaemonConfig* config;
   std::string file;
@@ -278,11 +285,8 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
     }
   } else if (sec == "slam") {
     if (key == "mode") {
-      const std::string m(v);
-      if (m == "dpslam") c.mode = SlamMode::kDpSlam;
-      else if (m == "sdp") c.mode = SlamMode::kSdp;
-      else {
-        *why = "'" + m + "' is not a SLAM mode (dpslam, sdp)";
+      if (!parse_mode(v, &c.mode)) {
+        *why = "'" + std::string(v) + "' is not a SLAM mode (dpslam, sdp)";
         return R::kBad;
       }
       return R::kOk;
@@ -378,8 +382,7 @@ int profile_handler(void* user, const char* section, const char* name, const cha
   auto* c = static_cast<DaemonConfig*>(user);
   if (name == nullptr || std::strcmp(section, "slam") != 0) return 1;
   if (std::strcmp(name, "mode") == 0) {
-    if (std::strcmp(value, "sdp") == 0) c->mode = SlamMode::kSdp;
-    if (std::strcmp(value, "dpslam") == 0) c->mode = SlamMode::kDpSlam;
+    (void)parse_mode(value, &c->mode);
   } else if (std::strcmp(name, "profile") == 0) {
     (void)parse_sdp_profile(value, &c->profile);
   }

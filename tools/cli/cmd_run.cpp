@@ -36,13 +36,14 @@ int report(const char* what, int code, const std::string& error) {
   return code;
 }
 
-// `config` holds the profile's bottom-level options with the file's keys on top.
-int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, SdpProfile profile) {
+// `config` holds the profile's bottom-level options with the file's keys on top; `sdp`
+// the profile's top-level options, the file's [sdp] keys go on top of them here.
+int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOptions& sdp, SdpProfile profile) {
   slam::SdpRunOptions ro;
   ro.config = config;
+  ro.sdp = sdp;
   ro.profile = profile;
   std::string error;
-  apply_profile(profile, nullptr, &ro.sdp);
   if (!a.config.empty() && !slam::load_sdp_ini(a.config, &ro.sdp, &error)) {
     return report("", kExitBadInput, error);
   }
@@ -126,12 +127,13 @@ std::function<int()> setup_run(CLI::App& app) {
     SdpProfile profile = kDefaultSdpProfile;
     if (!args->profile.empty()) (void)parse_sdp_profile(args->profile.c_str(), &profile);  // checked by CLI11
     slam::SlamConfig config;
-    if (sdp) apply_profile(profile, &config.filter, nullptr);
+    SdpOptions sdp_options;
+    if (sdp) apply_profile(profile, &config.filter, &sdp_options);
     std::string error;
     if (!args->config.empty() && !slam::load_config_ini(args->config, &config, &error)) {
       return report("", kExitBadInput, error);
     }
-    return sdp ? run_sdp_mode(*args, config, profile) : run_dpslam_mode(*args, config);
+    return sdp ? run_sdp_mode(*args, config, sdp_options, profile) : run_dpslam_mode(*args, config);
   };
 }
 
