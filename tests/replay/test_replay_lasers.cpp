@@ -176,11 +176,14 @@ TEST(ReplayScipEngine, an_overtaken_scan_is_dropped_not_sent_late) {
 
 TEST_GROUP(ReplayLaserPty){};
 
-namespace {
-
-// One URG replay through the pty; every check but the timing bound is made here.
-// Returns the worst interval error (us) and the emulator's own worst lateness.
-void replay_urg_once(double* worst_timing_us_out, double* lateness_us_out) {
+// The sensor stamps are exact to the ms. The driver maps them onto the host clock with a
+// minimum-delay filter (scip2::SensorClock): its offset starts at the first scan's
+// delivery delay and can only shrink, so an interval between two delivered scans is
+// never longer than the log's (scaled by 1/speed) beyond the 1 ms of the stamps' grain,
+// whatever the machine's load. A driver that stamped arrival times would stretch the
+// interval after any scan delivered late. How far the intervals are off in all (the
+// first scan's excess delay, 10 ms on an idle machine) depends on the load: printed.
+TEST(ReplayLaserPty, urg_driver_reproduces_the_log_scans_in_order_within_a_millimetre) {
   const std::vector<ReplayScan> scans = synthetic_scans(25, 180, static_cast<float>(kPi / 179.0));
   ScipGeometry geo;
   std::string error;
@@ -217,7 +220,7 @@ void replay_urg_once(double* worst_timing_us_out, double* lateness_us_out) {
               static_cast<unsigned long long>(engine.stats().scans_late),
               static_cast<long long>(engine.stats().max_lateness_us));
   const std::vector<std::size_t> idx = check_delivery(scans, got, engine.stats());
-  double worst_mm = 0.0, worst_timing_us = 0.0;
+  double worst_mm = 0.0, worst_timing_us = 0.0, worst_stretch_us = -1e9;
   for (std::size_t j = 0; j < got.size(); ++j) {
     const std::size_t k = idx[j];
     const RangeScan& g = got[j];
@@ -238,31 +241,17 @@ void replay_urg_once(double* worst_timing_us_out, double* lateness_us_out) {
     const double want_us = static_cast<double>(scans[k].stamp_us - scans[idx[0]].stamp_us) / speed;
     const double have_us = static_cast<double>(g.stamp_us - got[0].stamp_us);
     worst_timing_us = std::fmax(worst_timing_us, std::fabs(have_us - want_us));
+    if (j > 0) {
+      const double want_step_us = static_cast<double>(scans[k].stamp_us - scans[idx[j - 1]].stamp_us) / speed;
+      const double have_step_us = static_cast<double>(g.stamp_us - got[j - 1].stamp_us);
+      worst_stretch_us = std::fmax(worst_stretch_us, have_step_us - want_step_us);
+    }
   }
-  std::printf("\nURG replay: %zu scans, worst range error %.3f mm, worst interval error %.0f us\n", got.size(),
-              worst_mm, worst_timing_us);
+  std::printf("\nURG replay: %zu scans, worst range error %.3f mm, worst interval error %.0f us, "
+              "longest stretch of one interval %.0f us\n",
+              got.size(), worst_mm, worst_timing_us, worst_stretch_us);
   CHECK_TRUE(worst_mm <= 1.0);
-  *worst_timing_us_out = worst_timing_us;
-  *lateness_us_out = static_cast<double>(engine.stats().max_lateness_us);
-}
-
-}  // namespace
-
-TEST(ReplayLaserPty, urg_driver_reproduces_the_log_scans_in_order_within_a_millimetre) {
-  // The sensor stamps are exact to the ms; the driver maps them with a minimum-delay
-  // filter that starts from the first scan's delay, which is what remains here: 10 ms on
-  // an idle machine, plus however late the emulator had to send. A loaded machine can
-  // also deliver the first scan to the driver late, which no emulator figure shows: the
-  // bound must hold in one of three replays (count, order and ranges in every one).
-  bool timely = false;
-  for (int attempt = 0; attempt < 3 && !timely; ++attempt) {
-    double worst_us = 0.0;
-    double lateness_us = 0.0;
-    replay_urg_once(&worst_us, &lateness_us);
-    timely = worst_us <= 10000.0 + lateness_us;
-    if (!timely) std::printf("URG replay %d: interval error %.0f us over the bound, replaying\n", attempt + 1, worst_us);
-  }
-  CHECK_TRUE(timely);
+  CHECK_TRUE_TEXT(worst_stretch_us <= 2000.0, "an interval between driver stamps is longer than the log's");
 }
 
 TEST(ReplayLaserPty, sick_driver_reproduces_the_log_scans_in_order_within_a_millimetre) {
@@ -287,10 +276,14 @@ TEST(ReplayLaserPty, sick_driver_reproduces_the_log_scans_in_order_within_a_mill
   sk.stall_timeout_us = 2000000;  // the emulator is silent until the log's first scan
   drivers::SickLms2xxLaser laser(port, clock, sk);
   std::vector<RangeScan> got;
+  std::vector<std::int64_t> got_at_us;  // when poll() handed the scan over
   const std::int64_t end = clock.now_us() + 8000000;
   RangeScan out;
   while (got.size() < scans.size() && clock.now_us() < end) {
-    if (laser.poll(out, 50000) == 1) got.push_back(out);
+    if (laser.poll(out, 50000) == 1) {
+      got.push_back(out);
+      got_at_us.push_back(clock.now_us());
+    }
   }
   player.thread.join();
   {
@@ -325,15 +318,17 @@ TEST(ReplayLaserPty, sick_driver_reproduces_the_log_scans_in_order_within_a_mill
     const double have_us = static_cast<double>(g.stamp_us - got[0].stamp_us);
     worst_timing_us = std::fmax(worst_timing_us, std::fabs(have_us - want_us));
     sum_timing_us += std::fabs(have_us - want_us);
+    // The stamp is the arrival of the telegram's last byte: not before the emulator was
+    // due to send it, not after the driver handed the scan over (one clock for both).
+    CHECK_TRUE(g.stamp_us >= player.player.timeline().due_us(scans[k].stamp_us));
+    CHECK_TRUE(g.stamp_us <= got_at_us[j]);
   }
   const double mean_timing_us = sum_timing_us / static_cast<double>(got.size());
   std::printf("\nSICK replay: %zu scans, worst range error %.3f mm, interval error mean %.0f us, worst %.0f us\n",
               got.size(), worst_mm, mean_timing_us, worst_timing_us);
   CHECK_TRUE(worst_mm <= 1.0);
   // The LMS2xx driver stamps a scan on the arrival of its last byte (there is no sensor
-  // clock in the telegram), so host scheduling delay goes straight into the stamp: on an
-  // idle machine 5 ms mean and 40 ms worst, plus however late the emulator had to send.
-  const double late_us = static_cast<double>(engine.stats().max_lateness_us);
-  CHECK_TRUE(mean_timing_us <= 5000.0 + late_us);
-  CHECK_TRUE(worst_timing_us <= 40000.0 + late_us);
+  // clock in the telegram), so host scheduling delay goes straight into the stamp and
+  // the interval errors printed above depend on the machine's load (on an idle machine
+  // under 5 ms mean and 40 ms worst); the bounds checked are the load-free ones above.
 }
