@@ -2,8 +2,8 @@
 # End-to-end run of sdpslamd on the host, checked exactly against the offline runner.
 #   e2e_host.sh SDPSLAMD REPLAY SDPSLAM MAKE_CANDUMP LOG WORK LINES SPEED [FIDELITY [MODE]]
 # MODE: dpslam (default: the bottom-level filter, 5 particles) or sdp (SDP-SLAM, 10 top /
-# 5 bottom particles, a segment every 6 processed scans, 3 live levels: in 150 lines
-# several segments end and older levels become permanent, so the trajectory holds
+# 5 bottom particles, a segment every 4 processed scans, 3 live levels: in 150 lines
+# (about 35 processed scans) several segments end and older levels become permanent, so the trajectory holds
 # permanent, live and current poses).
 # The first LINES lines of a tinySLAM log (real wheel ticks + URG scans): the scans are
 # served by a SCIP 2.0 emulator on a pty, the ticks as CANopen SYNC + TPDO1 frames
@@ -32,7 +32,7 @@ case $mode in
   # segmentation needs some period at every step.
   sdp) sdp_section='[sdp]
 top_particles = 10
-period_scans = 6
+period_scans = 4
 period_travel_m = 0
 min_segment_scans = 3
 max_segment_scans = 30
