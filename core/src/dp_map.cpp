@@ -364,6 +364,31 @@ void DpMap::release_observation(std::uint32_t e) {
   obs_pool_.release(&obs_[e]);
 }
 
+bool DpMap::pop_observation(NodeId node, std::int32_t* ix, std::int32_t* iy, CellObservation* value) {
+  if (tree_ == nullptr || !tree_->contains(node)) {
+    ++misuse_count_;
+    return false;
+  }
+  const std::uint32_t owner = node_owner_[node];
+  if (owner == kNone) return false;
+  const std::uint32_t e = owner_head_[owner];
+  const Observation& o = obs_[e];
+  const std::uint32_t table = tiles_[o.location >> (2U * kSideLog2)].table_index;
+  const std::uint32_t c = o.location & (capacity::kDpTileCells - 1U);
+  *ix = static_cast<std::int32_t>(((table % tiles_x_) << kSideLog2) | (c & kSideMask));
+  *iy = static_cast<std::int32_t>(((table / tiles_x_) << kSideLog2) | (c >> kSideLog2));
+  *value = o.value;
+  const std::uint32_t next = o.next_in_node;
+  release_observation(e);
+  if (next == kNone) {
+    release_owner(owner);
+  } else {
+    owner_head_[owner] = next;
+    --owner_count_[owner];
+  }
+  return true;
+}
+
 void DpMap::remove_node(NodeId node) {
   if (tree_ == nullptr || node >= node_capacity_) {
     ++misuse_count_;

@@ -312,6 +312,12 @@ bool DpSlamFilter::release_anchored(NodeId node) {
   return true;
 }
 
+bool DpSlamFilter::pop_anchored_observation(NodeId node, std::int32_t* ix, std::int32_t* iy,
+                                            CellObservation* value) {
+  if (is_particle_node(node)) return false;
+  return map_.pop_observation(node, ix, iy, value);
+}
+
 NodeId DpSlamFilter::create_anchored_root() { return initialised_ ? tree_.create_root() : kNoNode; }
 
 bool DpSlamFilter::add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits,

@@ -553,7 +553,35 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   if (r.width == 0U || global_node_ == kNoNode) {
     transfer_.next_row = r.height;
   }
-  while (transfer_.next_row < r.height && used < budget_cells) {
+  if (transfer_.mode == TransferMode::kUndecided) {
+    // Called once the level's other submaps are released (do_work, make_oldest_permanent).
+    const bool root = filter_->tree().parent(transfer_.node) == kNoNode;
+    transfer_.mode = root ? TransferMode::kPop : TransferMode::kRows;
+    ++(root ? stats_.map_transfers_popped : stats_.map_transfers_by_rows);
+  }
+  if (transfer_.mode == TransferMode::kPop && transfer_.next_row < r.height) {
+    std::int32_t ix = 0;
+    std::int32_t iy = 0;
+    CellObservation v{};
+    bool more = true;
+    while (used < budget_cells && (more = filter_->pop_anchored_observation(transfer_.node, &ix, &iy, &v))) {
+      used += kPopCostCells;
+      double cx = 0.0;
+      double cy = 0.0;
+      map.cell_center(ix, iy, &cx, &cy);
+      double gx = 0.0;
+      double gy = 0.0;
+      transfer_.frame.transform_point(cx, cy, gx, gy);
+      std::int32_t gix = 0;
+      std::int32_t giy = 0;
+      ++stats_.map_transfer_cells;
+      if (!map.world_to_cell(gx, gy, &gix, &giy) || !filter_->add_to_anchored(global_node_, gix, giy, v.hits, v.misses)) {
+        ++stats_.map_transfer_dropped;
+      }
+    }
+    if (!more) transfer_.next_row = r.height;
+  }
+  while (transfer_.mode == TransferMode::kRows && transfer_.next_row < r.height && used < budget_cells) {
     // A strip fits the work buffers and what is left of the budget (at least one row).
     std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / r.width);
     const std::uint32_t budget_rows = (budget_cells - used) / r.width;
@@ -606,7 +634,9 @@ std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
   // The permanent submap's copy into the global map first, in strips within the budget:
   // its observations (and the tiles only it holds) are freed when it completes, and the
   // pool is what the bottom level's new observations come from.
-  if (transfer_.active && used < budget_cells) used += transfer_rows(budget_cells - used);
+  // It waits for the releases (one per call): they let prune fold the submap's lineage
+  // into its node, which can then be popped.
+  if (transfer_.active && release_count_ == 0U && used < budget_cells) used += transfer_rows(budget_cells - used);
   if (used >= budget_cells) return used;
   // Skeletons of the live levels, oldest first, in slices.
   if (skeleton_job_.active) used += skeleton_work(budget_cells - used);

@@ -164,6 +164,54 @@ TEST(DpMap, removing_a_node_frees_its_observations_and_empty_tiles) {
   CHECK_TRUE(view_is(f.map, b, 0, 0, obs(0, 1)));
 }
 
+// A chain folded by prune leaves a root that owns its whole view: popping it hands every
+// known cell out once, with the view's value, frees each observation and empty tile as
+// it goes, and what the node still owns (its view) is exactly what was not popped.
+TEST(DpMap, popping_a_root_hands_out_its_whole_view_once_and_frees_it) {
+  DpFixture f(8U, 8U, small_options(9U, 64U));
+  auto& t = f.tree;
+  const NodeId r = t.create_root();
+  CHECK_TRUE(f.map.update(r, 0, 0, obs(1, 1)));
+  CHECK_TRUE(f.map.update(r, 5, 7, obs(2, 0)));
+  const NodeId a = t.add_child(r);
+  CHECK_TRUE(f.map.update(a, 0, 0, obs(3, 4)));    // shadows r's
+  CHECK_TRUE(f.map.update(a, 40, 30, obs(0, 9)));  // another tile
+  const NodeId other = t.create_root();           // another tree: untouched
+  CHECK_TRUE(f.map.update(other, 5, 7, obs(7, 7)));
+  t.set_active(r, false);
+  t.prune(&f.map);  // r folds into a
+  LONGS_EQUAL(kNoNode, t.parent(a));
+  LONGS_EQUAL(3, f.map.observation_count(a));
+  LONGS_EQUAL(2, f.map.tiles_used());  // (0,0) and (5,7) share one
+  std::vector<CellObservation> want{obs(3, 4), obs(2, 0), obs(0, 9)};  // (0,0) (5,7) (40,30)
+  std::vector<int> seen(3, 0);
+  std::int32_t ix = 0;
+  std::int32_t iy = 0;
+  CellObservation v;
+  for (std::uint32_t left = 3U; left > 0U; --left) {
+    CHECK_TRUE(f.map.pop_observation(a, &ix, &iy, &v));
+    const int k = (ix == 0 && iy == 0) ? 0 : (ix == 5 && iy == 7) ? 1 : (ix == 40 && iy == 30) ? 2 : -1;
+    CHECK_TRUE(k >= 0);
+    CHECK_TRUE(v == want[static_cast<std::size_t>(k)]);
+    ++seen[static_cast<std::size_t>(k)];
+    CellObservation still;
+    CHECK_FALSE(f.map.lookup(a, ix, iy, &still));  // gone from the view
+    LONGS_EQUAL(left - 1U, f.map.observation_count(a));
+    CHECK_TRUE(f.map.invariants_hold());
+  }
+  CHECK_TRUE(seen == std::vector<int>(3, 1));
+  CHECK_FALSE(f.map.pop_observation(a, &ix, &iy, &v));
+  LONGS_EQUAL(1, f.map.observations_used());  // the other tree's
+  LONGS_EQUAL(1, f.map.tiles_used());
+  CHECK_TRUE(view_is(f.map, other, 5, 7, obs(7, 7)));
+  // A dead node is misuse, counted; the node itself stays live and writable.
+  const std::uint32_t misuse = f.map.misuse_count();
+  CHECK_FALSE(f.map.pop_observation(static_cast<NodeId>(7U), &ix, &iy, &v));
+  LONGS_EQUAL(misuse + 1U, f.map.misuse_count());
+  CHECK_TRUE(f.map.update(a, 1, 1, obs(1, 0)));
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
 TEST(DpMap, merge_relabels_to_the_child_except_where_the_child_is_newer) {
   DpFixture f(8U, 8U, small_options(4U, 64U));
   auto& t = f.tree;

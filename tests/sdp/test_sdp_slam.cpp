@@ -261,10 +261,15 @@ TEST(SdpSlam, map_transfer_is_cut_to_the_per_scan_budget_and_still_completes) {
   const SdpStats& st = rig.slam->stats();
   CHECK(st.levels_made_permanent > 0U);
   CHECK(st.map_transfer_cells > 0U);
+  // Every copy popped the submap's node: once its siblings were released, prune had
+  // folded its lineage into it (no copy fell back to reading its rectangle).
+  LONGS_EQUAL(st.levels_made_permanent, st.map_transfers_popped);
+  LONGS_EQUAL(0, st.map_transfers_by_rows);
   // Every permanent submap but the last was copied and released while scans came in.
   CHECK(st.submaps_released >= st.levels_made_permanent * 5U - 1U);
-  // Budget, plus the last strip started within it (one row of a transfer or two fine rows
-  // of a skeleton patch, at most 16 m = 320 cells wide), plus the release of one submap.
+  // Budget, plus the last strip started within it (one popped observation, or two fine
+  // rows of a skeleton patch, at most 16 m = 320 cells wide), plus the release of one
+  // submap.
   CHECK(most <= s.work_cells_per_scan + 2U * 322U + 1U);
   CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
 }

@@ -165,6 +165,14 @@ class DpMap final : public TreeListener {
   // one find_view() (whose answer, if the particle's own, is updated in place).
   bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
 
+  // Removes the newest observation `node` owns and gives its cell and value: false iff
+  // `node` owns none, or is not a live tree node (misuse_count). A root of the forest
+  // has no ancestors, so what it owns is its whole view: popping until false hands its
+  // map out once per known cell, in no spatial order, and frees the observations (and
+  // tiles left empty) as it goes; what it still owns is exactly what has not been handed
+  // out. SDP-SLAM copies a permanent submap into the global map this way. O(1) expected.
+  bool pop_observation(NodeId node, std::int32_t* ix, std::int32_t* iy, CellObservation* value);
+
   // ---- extraction --------------------------------------------------------------------
   // Calls f(ix, iy, const CellObservation&) for every cell `particle` knows, in raster
   // order of tiles (row-major) and of cells within a tile. O(tiles in table + cells of

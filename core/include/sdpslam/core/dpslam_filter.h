@@ -132,6 +132,9 @@ class DpSlamFilter {
   // Adds evidence to cell (ix, iy) of a node that is not a current particle (same
   // failure rules as DpMap::add, plus false iff `node` is a current particle).
   bool add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
+  // DpMap::pop_observation() on a node that is not a current particle (false, changing
+  // nothing, for a particle's node).
+  bool pop_anchored_observation(NodeId node, std::int32_t* ix, std::int32_t* iy, CellObservation* value);
   std::uint32_t restart_refused_count() const { return restart_refused_count_; }
 
   const DpMap& map() const { return map_; }

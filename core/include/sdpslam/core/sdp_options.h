@@ -63,7 +63,10 @@ struct SdpOptions {
   double skeleton_min_clearance_m = 0.2;
   double occupied_threshold = 0.6;  // occupancy >= this is an obstacle
   double free_threshold = 0.35;     // occupancy <= this is free
-  std::uint32_t work_cells_per_scan = 120000U;  // map cells read per scan by anchorage work
+  // Map cells read per scan by anchorage work: skeleton patches, and the copy of a
+  // permanent submap into the global map (one popped observation counts
+  // SdpSlam::kPopCostCells; see SdpSlam::Transfer).
+  std::uint32_t work_cells_per_scan = 120000U;
   // Beyond the paper (per-scan time): true = the top level's work (anchorage, evaluations,
   // loop search) waits while the bottom level processes scans, so that the two costs do
   // not add up in one scan; it runs on the scans the bottom level skips (most of them:

@@ -110,6 +110,8 @@ struct SdpStats {
   std::uint64_t skeleton_truncated_points = 0U;
   std::uint64_t map_transfer_cells = 0U;
   std::uint64_t map_transfer_dropped = 0U;  // global-map cell updates refused (pool full)
+  std::uint64_t map_transfers_popped = 0U;  // permanent submaps copied by popping (the rule)
+  std::uint64_t map_transfers_by_rows = 0U; // ... by reading their rectangle (fallback)
   std::uint64_t rounds = 0U;
   std::uint64_t top_work_deferred = 0U;     // processed scans whose top-level work waited (defer_top_work)
   std::uint64_t rounds_with_overlap = 0U;
@@ -287,13 +289,24 @@ class SdpSlam {
     std::uint32_t coarse_height = 0U;
     std::uint32_t next_coarse_row = 0U;
   };
+  // The copy of a permanent submap into the global map node. Once the level's other
+  // submaps are released, prune has merged the submap's whole lineage into its node
+  // (every ancestor was inactive with one child), which is then a root: its
+  // observations are popped one by one (kPop: work in proportion to its known cells,
+  // and the pool refills as it goes). Otherwise the rectangle is read in strips of rows
+  // (kRows, the fallback: work in proportion to the rectangle's area).
+  enum class TransferMode : std::uint8_t { kUndecided, kPop, kRows };
   struct Transfer {
     bool active = false;
+    TransferMode mode = TransferMode::kUndecided;
     NodeId node = kNoNode;
     Pose2 frame;
     CellRect rect{};
     std::uint32_t next_row = 0U;
   };
+  // Budget cells one popped observation counts for: it is a read and a global-map
+  // update, each a cell-list search, where a strip's cell is one read and mostly empty.
+  static constexpr std::uint32_t kPopCostCells = 4U;
   class RingSink final : public PoseSink {
    public:
     explicit RingSink(SdpSlam& owner) : owner_(owner) {}
@@ -501,6 +514,8 @@ void SdpSlam::for_each_best_submap(F&& f) const {
   CellRect all{};
   if (global_node_ != kNoNode && filter_->map().touched_bounds(&all)) f(global_node_, Pose2{}, all);
   if (transfer_.active) {
+    // What the global node does not hold yet: a popped node keeps only the cells not
+    // copied; in strips, the rows not copied.
     CellRect rest = transfer_.rect;
     rest.iy0 += static_cast<std::int32_t>(transfer_.next_row);
     rest.height -= transfer_.next_row;
