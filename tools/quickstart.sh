@@ -11,7 +11,8 @@
 #
 # Works on a fresh Debian 12 with a compiler and CMake; installs Debian packages as root
 # or through sudo. Environment: SDPSLAM_JOBS (parallel build jobs, default: nproc),
-# SDPSLAM_FUZZ_SECONDS (per fuzzer, default 20), SDPSLAM_SKIP_INSTALL=1 (no apt-get).
+# SDPSLAM_FUZZ_SECONDS (per fuzzer, default 10: a smoke run; longer campaigns:
+# SDPSLAM_FUZZ_SECONDS=600 ctest --preset fuzz), SDPSLAM_SKIP_INSTALL=1 (no apt-get).
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -109,7 +110,7 @@ case "$mode" in
       if ! configure_build "$preset"; then failed+=("$preset(build)"); continue; fi
       log "test: $preset"
       if [ "$preset" = fuzz ]; then
-        export SDPSLAM_FUZZ_SECONDS=${SDPSLAM_FUZZ_SECONDS:-20}
+        export SDPSLAM_FUZZ_SECONDS=${SDPSLAM_FUZZ_SECONDS:-10}
       fi
       ctest --preset "$preset" -j "$jobs" || failed+=("$preset")
     done
@@ -121,7 +122,7 @@ case "$mode" in
     echo "all test presets passed: host-debug host-asan aarch64 fuzz"
     ;;
   *)
-    sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
     ;;
 esac
