@@ -545,6 +545,24 @@ void SdpSlam::make_oldest_permanent() {
   levels_[slot(level)].count = 0U;
 }
 
+// One cell of the permanent submap into the global map node, at its place in the global
+// frame; counted, and counted as dropped when outside the map or refused (pool full).
+void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v) {
+  const DpMap& map = filter_->map();
+  double cx = 0.0;
+  double cy = 0.0;
+  map.cell_center(ix, iy, &cx, &cy);
+  double gx = 0.0;
+  double gy = 0.0;
+  transfer_.frame.transform_point(cx, cy, gx, gy);
+  std::int32_t gix = 0;
+  std::int32_t giy = 0;
+  ++stats_.map_transfer_cells;
+  if (!map.world_to_cell(gx, gy, &gix, &giy) || !filter_->add_to_anchored(global_node_, gix, giy, v.hits, v.misses)) {
+    ++stats_.map_transfer_dropped;
+  }
+}
+
 std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   if (!transfer_.active) return 0U;
   const DpMap& map = filter_->map();
@@ -566,18 +584,7 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
     bool more = true;
     while (used < budget_cells && (more = filter_->pop_anchored_observation(transfer_.node, &ix, &iy, &v))) {
       used += kPopCostCells;
-      double cx = 0.0;
-      double cy = 0.0;
-      map.cell_center(ix, iy, &cx, &cy);
-      double gx = 0.0;
-      double gy = 0.0;
-      transfer_.frame.transform_point(cx, cy, gx, gy);
-      std::int32_t gix = 0;
-      std::int32_t giy = 0;
-      ++stats_.map_transfer_cells;
-      if (!map.world_to_cell(gx, gy, &gix, &giy) || !filter_->add_to_anchored(global_node_, gix, giy, v.hits, v.misses)) {
-        ++stats_.map_transfer_dropped;
-      }
+      transfer_cell(ix, iy, v);
     }
     if (!more) transfer_.next_row = r.height;
   }
@@ -597,19 +604,7 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
       for (std::uint32_t x = 0; x < strip.width; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * strip.width + x;
         if (fine_known_[i] == 0U) continue;
-        double cx = 0.0;
-        double cy = 0.0;
-        map.cell_center(strip.ix0 + static_cast<std::int32_t>(x), strip.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
-        double gx = 0.0;
-        double gy = 0.0;
-        transfer_.frame.transform_point(cx, cy, gx, gy);
-        std::int32_t gix = 0;
-        std::int32_t giy = 0;
-        ++stats_.map_transfer_cells;
-        if (!map.world_to_cell(gx, gy, &gix, &giy) ||
-            !filter_->add_to_anchored(global_node_, gix, giy, fine_values_[i].hits, fine_values_[i].misses)) {
-          ++stats_.map_transfer_dropped;
-        }
+        transfer_cell(strip.ix0 + static_cast<std::int32_t>(x), strip.iy0 + static_cast<std::int32_t>(y), fine_values_[i]);
       }
     }
     transfer_.next_row += rows;

@@ -358,6 +358,7 @@ class SdpSlam {
   void start_skeleton(std::uint32_t level, std::uint32_t node);
   std::uint32_t skeleton_work(std::uint32_t budget_cells);  // the job, within the budget
   std::uint32_t transfer_rows(std::uint32_t budget_cells);
+  void transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v);
   std::uint32_t release_one();
   void rank_particles();
   void resample_and_diversify();
