@@ -22,11 +22,24 @@ void mat_vec(const double* a, const double* v, double* out) {
 void mat_t_vec(const double* a, const double* v, double* out) {
   for (int r = 0; r < 3; ++r) out[r] = a[0 * 3 + r] * v[0] + a[1 * 3 + r] * v[1] + a[2 * 3 + r] * v[2];
 }
-// aᵀ diag(w) b added into out.
-void add_at_w_b(const double* a, const double* w, const double* b, double* out) {
+// out = w Ω v, Ω the constraint's information (FrameInfo), w the kernel weight.
+void weighted(const FrameInfo& info, double w, const double* v, double* out) {
+  out[0] = w * (info.xx * v[0] + info.xy * v[1]);
+  out[1] = w * (info.xy * v[0] + info.yy * v[1]);
+  out[2] = w * (info.theta * v[2]);
+}
+// aᵀ (w Ω) b added into out.
+void add_at_w_b(const double* a, const FrameInfo& info, double w, const double* b, double* out) {
+  double wb[9];  // w Ω b, column by column
+  for (int c = 0; c < 3; ++c) {
+    const double col[3] = {b[0 * 3 + c], b[1 * 3 + c], b[2 * 3 + c]};
+    double t[3];
+    weighted(info, w, col, t);
+    for (int r = 0; r < 3; ++r) wb[r * 3 + c] = t[r];
+  }
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
-      out[r * 3 + c] += a[0 * 3 + r] * w[0] * b[0 * 3 + c] + a[1 * 3 + r] * w[1] * b[1 * 3 + c] + a[2 * 3 + r] * w[2] * b[2 * 3 + c];
+      out[r * 3 + c] += a[0 * 3 + r] * wb[0 * 3 + c] + a[1 * 3 + r] * wb[1 * 3 + c] + a[2 * 3 + r] * wb[2 * 3 + c];
     }
   }
 }
@@ -49,9 +62,9 @@ bool inverse3(const double* m, double* out) {
   out[8] = (m[0] * m[4] - m[1] * m[3]) * inv;
   return true;
 }
-// eᵀ Ω e for a diagonal Ω.
+// eᵀ Ω e.
 double weighted_sq(const FrameInfo& info, const double* e) {
-  return info.xy * (e[0] * e[0] + e[1] * e[1]) + info.theta * e[2] * e[2];
+  return info.xx * e[0] * e[0] + 2.0 * info.xy * e[0] * e[1] + info.yy * e[1] * e[1] + info.theta * e[2] * e[2];
 }
 double dot(const double* a, const double* b, std::size_t n) {
   double s = 0.0;
@@ -60,6 +73,62 @@ double dot(const double* a, const double* b, std::size_t n) {
 }
 
 }  // namespace
+
+// λ± = (a+c)/2 ± sqrt(((a−c)/2)² + b²); the eigenvector of λ+ is (b, λ+ − a) or
+// (λ+ − c, b), whichever is longer (the other may vanish).
+void symmetric2_eigen(double a, double b, double c, double* major, double* minor, double* ux, double* uy) {
+  const double half_diff = 0.5 * (a - c);
+  const double root = det::sqrt(half_diff * half_diff + b * b);
+  *major = 0.5 * (a + c) + root;
+  *minor = 0.5 * (a + c) - root;
+  double x = b, y = *major - a;
+  const double x2 = *major - c, y2 = b;
+  if (x2 * x2 + y2 * y2 > x * x + y * y) {
+    x = x2;
+    y = y2;
+  }
+  const double norm = det::sqrt(x * x + y * y);
+  if (norm > 0.0) {
+    *ux = x / norm;
+    *uy = y / norm;
+  } else {
+    *ux = 1.0;
+    *uy = 0.0;
+  }
+}
+
+FrameInfo FrameInfo::from_directions(double sigma_xy_m, double sigma_theta_rad, double m_xx, double m_xy,
+                                     double m_yy, double floor, double z_heading_rad) {
+  const FrameInfo iso = from_sigma(sigma_xy_m, sigma_theta_rad);
+  double major = 0.0, minor = 0.0, ux = 1.0, uy = 0.0;
+  symmetric2_eigen(m_xx, m_xy, m_yy, &major, &minor, &ux, &uy);
+  auto share = [floor](double lambda) {
+    const double k = 2.0 * lambda;
+    if (!(k > floor)) return floor;  // NaN too
+    return k > 1.0 ? 1.0 : k;
+  };
+  const double k_major = share(major) * iso.xx;
+  const double k_minor = share(minor) * iso.xx;
+  // Ω_i = k− I + (k+ − k−) u uᵀ, then R_zᵀ Ω_i R_z (R_z's columns: (c, s) and (−s, c)).
+  const double d = k_major - k_minor;
+  const double axx = k_minor + d * ux * ux;
+  const double axy = d * ux * uy;
+  const double ayy = k_minor + d * uy * uy;
+  const double c = det::cos(z_heading_rad);
+  const double s = det::sin(z_heading_rad);
+  FrameInfo info = iso;
+  info.xx = c * c * axx + 2.0 * c * s * axy + s * s * ayy;
+  info.yy = s * s * axx - 2.0 * c * s * axy + c * c * ayy;
+  info.xy = c * s * (ayy - axx) + (c * c - s * s) * axy;
+  return info;
+}
+
+bool FrameInfo::valid() const {
+  constexpr double kMax = 1.0e12;
+  const bool finite = xx > -kMax && xx < kMax && xy > -kMax && xy < kMax && yy > -kMax && yy < kMax &&
+                      theta > -kMax && theta < kMax;  // written so that NaN fails too
+  return finite && xx > 0.0 && yy > 0.0 && theta > 0.0 && xx * yy - xy * xy > 0.0;
+}
 
 std::size_t FrameGraph::required_bytes(const FrameGraphOptions& o) {
   if (!o.valid()) return 0U;
@@ -97,7 +166,7 @@ void FrameGraph::clear() {
 }
 
 bool FrameGraph::add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info) {
-  if (!initialised_ || n_ >= options_.max_nodes) {
+  if (!initialised_ || n_ >= options_.max_nodes || !info.valid()) {
     ++stats_.refused_nodes;
     return false;
   }
@@ -109,7 +178,7 @@ bool FrameGraph::add_node(const Pose2& estimate, const Pose2& from_previous, con
 
 bool FrameGraph::add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info, double robust_chi) {
   if (!initialised_ || loops_ >= options_.max_loops || i >= n_ || j >= n_ || i == j || robust_chi < 0.0 ||
-      !(robust_chi == robust_chi)) {
+      !(robust_chi == robust_chi) || !info.valid()) {
     ++stats_.refused_loops;
     return false;
   }
@@ -160,7 +229,6 @@ double FrameGraph::chi2(const Constraint& c) const {
 void FrameGraph::multiply(const double* v, double* out) const {
   for (std::uint32_t k = 0; k < 3U * n_; ++k) out[k] = 0.0;
   auto edge = [&](const Constraint& c, const Linear& l) {
-    const double w[3] = {l.w * c.info.xy, l.w * c.info.xy, l.w * c.info.theta};
     double jv[3] = {0.0, 0.0, 0.0};
     double t[3];
     if (c.i != 0U) {
@@ -171,7 +239,9 @@ void FrameGraph::multiply(const double* v, double* out) const {
       mat_vec(l.b, v + 3U * c.j, t);
       for (int r = 0; r < 3; ++r) jv[r] += t[r];
     }
-    for (int r = 0; r < 3; ++r) jv[r] *= w[r];
+    double wjv[3];
+    weighted(c.info, l.w, jv, wjv);
+    for (int r = 0; r < 3; ++r) jv[r] = wjv[r];
     if (c.i != 0U) {
       mat_t_vec(l.a, jv, t);
       for (int r = 0; r < 3; ++r) out[3U * c.i + static_cast<std::uint32_t>(r)] += t[r];
@@ -194,10 +264,9 @@ bool FrameGraph::factorise() {
     upper_[k] = 0.0;
   }
   auto add_diag = [&](const Constraint& c, const Linear& l, bool with_upper) {
-    const double w[3] = {l.w * c.info.xy, l.w * c.info.xy, l.w * c.info.theta};
-    if (c.i != 0U) add_at_w_b(l.a, w, l.a, diag_inv_ + 9U * c.i);
-    if (c.j != 0U) add_at_w_b(l.b, w, l.b, diag_inv_ + 9U * c.j);
-    if (with_upper && c.i != 0U) add_at_w_b(l.a, w, l.b, upper_ + 9U * c.i);  // block (i, i+1)
+    if (c.i != 0U) add_at_w_b(l.a, c.info, l.w, l.a, diag_inv_ + 9U * c.i);
+    if (c.j != 0U) add_at_w_b(l.b, c.info, l.w, l.b, diag_inv_ + 9U * c.j);
+    if (with_upper && c.i != 0U) add_at_w_b(l.a, c.info, l.w, l.b, upper_ + 9U * c.i);  // block (i, i+1)
   };
   for (std::uint32_t k = 1; k < n_; ++k) add_diag(seq_[k], lin_[k], true);
   for (std::uint32_t q = 0; q < loops_; ++q) add_diag(loop_[q], lin_[options_.max_nodes + q], false);
@@ -271,7 +340,8 @@ void FrameGraph::optimise() {
       r[k] = 0.0;
     }
     auto add_b = [&](const Constraint& c, const Linear& l) {
-      const double we[3] = {l.w * c.info.xy * l.e[0], l.w * c.info.xy * l.e[1], l.w * c.info.theta * l.e[2]};
+      double we[3];
+      weighted(c.info, l.w, l.e, we);
       double t[3];
       if (c.i != 0U) {
         mat_t_vec(l.a, we, t);

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "sdpslam/core/det_math.h"
+#include "sdpslam/core/frame_graph.h"  // symmetric2_eigen
 
 namespace sdpslam {
 namespace {
@@ -253,6 +254,117 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
   r.rms_nn_error_m = det::sqrt(sum_d2 / static_cast<double>(matched));
   r.status = r.converged ? Icp2dResult::Status::kConverged : Icp2dResult::Status::kMaxIterations;
   return r;
+}
+
+// Principal axes of the target points within radius_m of target[i] (itself included):
+// covariance C = [a b; b c], eigenvalues λ± = (a+c)/2 ± sqrt(((a−c)/2)² + b²). Line-like
+// when there are at least 3 points and λ− <= kLineRatio λ+; the normal is then
+// perpendicular to the eigenvector of λ+ (symmetric2_eigen).
+bool Icp2d::line_normal(const Point2* target, std::uint32_t i, double radius_m, double& nx, double& ny) {
+  constexpr double kLineRatio = 0.1;
+  if (normal_state_[i] != 0U) {
+    nx = normal_x_[i];
+    ny = normal_y_[i];
+    return normal_state_[i] == 1U;
+  }
+  normal_state_[i] = 2U;
+  const double px = target[i].x_m;
+  const double py = target[i].y_m;
+  const double r2 = radius_m * radius_m;
+  const auto reach = static_cast<std::int64_t>(radius_m / cell_m_) + 1;
+  // Two passes over the same cells in a fixed order (mean, then centred moments).
+  auto visit = [&](auto&& f) {
+    for (std::int64_t dy = -reach; dy <= reach; ++dy) {
+      for (std::int64_t dx = -reach; dx <= reach; ++dx) {
+        const std::int64_t qx = cell_x_[i] + dx;
+        const std::int64_t qy = cell_y_[i] + dy;
+        for (std::uint32_t k = heads_[bucket_of(qx, qy)]; k != kNone; k = next_[k]) {
+          if (cell_x_[k] != qx || cell_y_[k] != qy) continue;  // hash collision
+          const double ex = target[k].x_m - px;
+          const double ey = target[k].y_m - py;
+          if (ex * ex + ey * ey <= r2) f(ex, ey);
+        }
+      }
+    }
+  };
+  std::uint32_t count = 0U;
+  double sx = 0.0, sy = 0.0;
+  visit([&](double ex, double ey) {
+    ++count;
+    sx += ex;
+    sy += ey;
+  });
+  if (count < 3U) return false;
+  const double mx = sx / static_cast<double>(count);
+  const double my = sy / static_cast<double>(count);
+  double a = 0.0, b = 0.0, c = 0.0;
+  visit([&](double ex, double ey) {
+    const double u = ex - mx;
+    const double v = ey - my;
+    a += u * u;
+    b += u * v;
+    c += v * v;
+  });
+  double major = 0.0, minor = 0.0, ux = 1.0, uy = 0.0;
+  symmetric2_eigen(a, b, c, &major, &minor, &ux, &uy);
+  if (!(major > 0.0) || minor > kLineRatio * major) return false;
+  nx = -uy;
+  ny = ux;
+  normal_x_[i] = nx;
+  normal_y_[i] = ny;
+  normal_state_[i] = 1U;
+  return true;
+}
+
+bool Icp2d::direction_information(const Point2* target, std::size_t target_count, const Point2* source,
+                                  std::size_t source_count, const Pose2& transform, const Icp2dOptions& options,
+                                  double normal_radius_m, Icp2dInformation* out) {
+  if (out == nullptr || !options.valid() || !(normal_radius_m > 0.0) || normal_radius_m > 100.0 * options.nn_cell_m) {
+    return false;
+  }
+  if ((target == nullptr && target_count > 0U) || (source == nullptr && source_count > 0U)) return false;
+  if (target_count == 0U || target_count > capacity::kMaxIcpPoints || source_count > capacity::kMaxIcpPoints) {
+    return false;
+  }
+  if (!coordinates_ok(target, target_count) || !coordinates_ok(source, source_count)) return false;
+  if (!(transform.x_m > -kMaxAbsCoordinate_m && transform.x_m < kMaxAbsCoordinate_m &&
+        transform.y_m > -kMaxAbsCoordinate_m && transform.y_m < kMaxAbsCoordinate_m &&
+        transform.heading_rad > -1.0e3 && transform.heading_rad < 1.0e3)) {
+    return false;
+  }
+  const auto n_target = static_cast<std::uint32_t>(target_count);
+  const auto n_source = static_cast<std::uint32_t>(source_count);
+  build_index(target, n_target, options.nn_cell_m);
+  for (std::uint32_t i = 0; i < n_target; ++i) normal_state_[i] = 0U;
+  const double c = det::cos(transform.heading_rad);
+  const double s = det::sin(transform.heading_rad);
+  Icp2dInformation info;
+  double xx = 0.0, xy = 0.0, yy = 0.0;
+  for (std::uint32_t i = 0; i < n_source; ++i) {
+    const double px = transform.x_m + c * source[i].x_m - s * source[i].y_m;
+    const double py = transform.y_m + s * source[i].x_m + c * source[i].y_m;
+    double d2 = 0.0;
+    const std::uint32_t j = nearest(target, px, py, options.max_correspondence_m, d2);
+    if (j == kNone) continue;
+    ++info.pairs;
+    double nx = 0.0, ny = 0.0;
+    if (line_normal(target, j, normal_radius_m, nx, ny)) {
+      xx += nx * nx;
+      xy += nx * ny;
+      yy += ny * ny;
+      ++info.line_pairs;
+    } else {
+      xx += 0.5;
+      yy += 0.5;
+    }
+  }
+  if (info.pairs == 0U) return false;
+  const double inv = 1.0 / static_cast<double>(info.pairs);
+  info.xx = xx * inv;
+  info.xy = xy * inv;
+  info.yy = yy * inv;
+  *out = info;
+  return true;
 }
 
 }  // namespace sdpslam

@@ -82,6 +82,8 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("segment_sigma_theta_rad", segment_sigma_theta_rad, 1.0e-5, 10.0);
   c.real("loop_sigma_xy_m", loop_sigma_xy_m, 1.0e-4, 100.0);
   c.real("loop_sigma_theta_rad", loop_sigma_theta_rad, 1.0e-5, 10.0);
+  c.real("loop_normal_radius_m", loop_normal_radius_m, 0.0, 2.0);
+  c.real("loop_weak_direction_floor", loop_weak_direction_floor, 1.0e-4, 1.0);
   c.real("loop_robust_chi", loop_robust_chi, 1.0e-3, 1.0e3);
   c.integer("max_loop_constraints", max_loop_constraints, 1U, capacity::kMaxLoopConstraints);
   c.integer("graph_iterations", graph_iterations, 1U, 50U);
@@ -93,6 +95,9 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("loop_search_robust_chi", loop_search_robust_chi, 1.0e-3, 1.0e3);
   c.integer("loop_search_reads_per_scan", loop_search_reads_per_scan, 10000U, 1000000000U);
   if (c.ok && !icp.valid()) c.fail("icp: options out of range (see icp2d.h Icp2dOptions::valid)");
+  if (c.ok && loop_normal_radius_m > 100.0 * icp.nn_cell_m) {
+    c.fail("loop_normal_radius_m: more than 100 icp nearest-neighbour cells (see Icp2d::direction_information)");
+  }
   return c.ok;
 }
 

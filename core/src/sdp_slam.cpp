@@ -972,16 +972,14 @@ void SdpSlam::evaluate(std::uint32_t p) {
           if (tn >= options_.loop_min_pairs && sn_count >= options_.loop_min_pairs) {
             unpack(to, tn, obst_a_);
             unpack(live_obstacles(first + c.newer, chain_[c.newer]), sn_count, obst_b_);
-            Icp2dOptions fine = options_.icp;
-            fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
-            fine.min_pairs = options_.loop_min_pairs;
-            const Icp2dResult f = icp_->match(obst_a_, tn, obst_b_, sn_count, r.transform, fine);
+            const Icp2dResult f = icp_->match(obst_a_, tn, obst_b_, sn_count, r.transform, loop_icp_options());
             ++stats_.loop_refinements;
             const Pose2 moved = between(guess, f.transform);
             if (f.usable() && f.mean_nn_error_m <= options_.loop_max_error_m && f.matched_pairs >= options_.loop_min_pairs &&
                 det::sqrt(moved.x_m * moved.x_m + moved.y_m * moved.y_m) <= options_.loop_max_correction_m) {
               lr.z = f.transform;
               lr.error_m = f.mean_nn_error_m;
+              lr.info = loop_information(obst_a_, tn, obst_b_, sn_count, f.transform);
               record_loop(lr);
             }
           }
@@ -1140,6 +1138,36 @@ bool SdpSlam::loop_record_dead(const LoopRecord& r) const {
   return !graph_index(r.older_level, &index) || !graph_index(r.newer_level, &index);
 }
 
+Icp2dOptions SdpSlam::loop_icp_options() const {
+  Icp2dOptions fine = options_.icp;
+  fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
+  fine.min_pairs = options_.loop_min_pairs;
+  return fine;
+}
+
+// The pairing's direction information M (icp2d.h) weights the constraint per direction
+// (FrameInfo::from_directions): a corridor match keeps its across-corridor information.
+FrameInfo SdpSlam::loop_information(const Point2* target, std::uint32_t target_count, const Point2* source,
+                                    std::uint32_t source_count, const Pose2& z) {
+  const FrameInfo iso = FrameInfo::from_sigma(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad);
+  if (!(options_.loop_normal_radius_m > 0.0)) return iso;
+  Icp2dInformation m;
+  if (!icp_->direction_information(target, target_count, source, source_count, z, loop_icp_options(),
+                                   options_.loop_normal_radius_m, &m)) {
+    ++stats_.loop_information_unmeasured;
+    return iso;
+  }
+  const FrameInfo info = FrameInfo::from_directions(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad, m.xx, m.xy,
+                                                    m.yy, options_.loop_weak_direction_floor, z.heading_rad);
+  if (!info.valid()) {
+    ++stats_.loop_information_unmeasured;
+    return iso;
+  }
+  // Weak: some direction keeps less than half of the isotropic information.
+  if (info.xx * info.yy - info.xy * info.xy < 0.5 * iso.xx * iso.yy) ++stats_.loop_constraints_weak_direction;
+  return info;
+}
+
 // One record per pair of levels (the lowest residual wins). When the store is full a
 // dead record makes room, else the worst record if the new one is better.
 void SdpSlam::record_loop(const LoopRecord& r) {
@@ -1181,7 +1209,6 @@ void SdpSlam::adjust_frames() {
   FrameGraph& g = frame_graph_;
   g.clear();
   const FrameInfo seg = FrameInfo::from_sigma(options_.segment_sigma_xy_m, options_.segment_sigma_theta_rad);
-  const FrameInfo loop = FrameInfo::from_sigma(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad);
   bool ok = true;
   for (std::uint32_t k = 0; k < perm_count_; ++k) {
     const Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
@@ -1207,7 +1234,7 @@ void SdpSlam::adjust_frames() {
     if (!graph_index(r.older_level, &a) || !graph_index(r.newer_level, &b)) continue;
     const double chi = r.searched ? loop_search_chi(options_.loop_search_robust_chi, r.older_level, r.newer_level)
                                   : options_.loop_robust_chi;
-    if (g.add_loop(a, b, r.z, loop, chi)) {
+    if (g.add_loop(a, b, r.z, r.info, chi)) {
       ++used;
     } else {
       ++stats_.frame_graph_refused;
@@ -1377,10 +1404,8 @@ void SdpSlam::loop_search_continue() {
     ++stats_.loop_search_failed;
     return;
   }
-  Icp2dOptions fine = options_.icp;
-  fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
-  fine.min_pairs = options_.loop_min_pairs;
-  const Icp2dResult f = icp_->match(search_a_, search_a_count_, search_b_, search_b_count_, c.transform, fine);
+  const Icp2dResult f =
+      icp_->match(search_a_, search_a_count_, search_b_, search_b_count_, c.transform, loop_icp_options());
   ++stats_.loop_refinements;
   // ICP only polishes the peak: it must stay within a coarse block of it.
   const Pose2 polish = between(c.transform, f.transform);
@@ -1396,6 +1421,7 @@ void SdpSlam::loop_search_continue() {
   lr.newer_level = search_pair_newer_;
   lr.z = f.transform;
   lr.error_m = f.mean_nn_error_m;
+  lr.info = loop_information(search_a_, search_a_count_, search_b_, search_b_count_, f.transform);
   lr.searched = true;
   record_loop(lr);
   if (!loop_record_dead(lr)) update_best();  // the frames follow the new constraint now

@@ -38,6 +38,8 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   DOUBLES_EQUAL(d.segment_sigma_theta_rad, o.segment_sigma_theta_rad, 0.0);
   DOUBLES_EQUAL(d.loop_sigma_xy_m, o.loop_sigma_xy_m, 0.0);
   DOUBLES_EQUAL(d.loop_sigma_theta_rad, o.loop_sigma_theta_rad, 0.0);
+  DOUBLES_EQUAL(d.loop_normal_radius_m, o.loop_normal_radius_m, 0.0);
+  DOUBLES_EQUAL(d.loop_weak_direction_floor, o.loop_weak_direction_floor, 0.0);
   DOUBLES_EQUAL(d.loop_robust_chi, o.loop_robust_chi, 0.0);
   LONGS_EQUAL(d.max_loop_constraints, o.max_loop_constraints);
   LONGS_EQUAL(d.graph_iterations, o.graph_iterations);
@@ -139,6 +141,12 @@ TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
   CHECK_TRUE_TEXT(why.find("loop_points") != std::string::npos, why.c_str());
   CHECK(slam::apply_sdp_key(&o, "loop_sigma_xy_m", "0", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "graph_iterations", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_normal_radius_m", "0", &why) == slam::SdpKeyResult::kApplied);
+  DOUBLES_EQUAL(0.0, o.loop_normal_radius_m, 0.0);
+  CHECK(slam::apply_sdp_key(&o, "loop_normal_radius_m", "2.5", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK_TRUE_TEXT(why.find("loop_normal_radius_m") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "loop_weak_direction_floor", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK(slam::apply_sdp_key(&o, "loop_weak_direction_floor", "1", &why) == slam::SdpKeyResult::kApplied);
   CHECK(slam::apply_sdp_key(&o, "max_loop_constraints", "2000000", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "loop_search_window_m", "6", &why) == slam::SdpKeyResult::kApplied);
   DOUBLES_EQUAL(6.0, o.loop_search_window_m, 0.0);

@@ -100,6 +100,15 @@ void fuzz_icp(Reader& in) {
   } else {
     require(!r.converged);
   }
+  // Direction information of the pairing found (or of the guess): trace 1, positive
+  // semi-definite, counts within bounds, whatever the points.
+  const double radius_m = 0.02 * (1 + (flags >> 1U) % 32U);
+  sdpslam::Icp2dInformation m;
+  if (icp.direction_information(target, nt, source, ns, r.transform, options, radius_m, &m)) {
+    require(m.pairs >= 1U && m.pairs <= ns && m.line_pairs <= m.pairs);
+    require(m.xx >= -1e-12 && m.yy >= -1e-12 && m.xx * m.yy - m.xy * m.xy >= -1e-12);
+    require(m.xx + m.yy > 1.0 - 1e-9 && m.xx + m.yy < 1.0 + 1e-9);
+  }
 }
 
 void fuzz_graph(Reader& in) {

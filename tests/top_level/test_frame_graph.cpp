@@ -1,7 +1,8 @@
 // FrameGraph (core/frame_graph.h): the loop-closure pose graph over submap frames.
 // A drifting chain around a square loop is pulled back onto the true frames by one loop
 // constraint; a wrong loop constraint among good ones is down-weighted by the kernel;
-// capacities refuse and count; results are bit-identical across runs.
+// a corridor match pulls across the corridor, not along it; capacities refuse and
+// count; results are bit-identical across runs.
 #include <cmath>
 #include <vector>
 
@@ -161,4 +162,64 @@ TEST(FrameGraph, invalid_options_and_a_small_arena_are_refused) {
   alignas(std::max_align_t) unsigned char tiny[256];
   Arena small(tiny, sizeof tiny);
   CHECK_FALSE(g.init(FrameGraphOptions{}, small));
+}
+
+// A corridor match fixes the frames across the corridor, not along it
+// (FrameInfo::from_directions): its information is rotated into the frame of Z.
+TEST(FrameGraph, direction_information_keeps_only_what_the_match_fixes) {
+  const double sigma = 0.1, floor = 0.02;
+  const FrameInfo iso = FrameInfo::from_sigma(sigma, 0.02);
+  // Every direction fixed (M = ½ I): the isotropic constraint, whatever Z's heading.
+  const FrameInfo all = FrameInfo::from_directions(sigma, 0.02, 0.5, 0.0, 0.5, floor, 0.7);
+  DOUBLES_EQUAL(iso.xx, all.xx, 1e-9 * iso.xx);
+  DOUBLES_EQUAL(iso.yy, all.yy, 1e-9 * iso.yy);
+  DOUBLES_EQUAL(0.0, all.xy, 1e-9 * iso.xx);
+  DOUBLES_EQUAL(iso.theta, all.theta, 0.0);
+  // A corridor along 30° in frame i (normals at 120°), Z turned by 50°: in Z's frame the
+  // corridor runs along −20°.
+  const double deg = kPi / 180.0;
+  const double nx = std::cos(120.0 * deg), ny = std::sin(120.0 * deg);
+  const FrameInfo c = FrameInfo::from_directions(sigma, 0.02, nx * nx, nx * ny, ny * ny, floor, 50.0 * deg);
+  CHECK_TRUE(c.valid());
+  auto along = [&](double angle) {  // vᵀ Ω v for the unit vector at `angle`
+    const double vx = std::cos(angle), vy = std::sin(angle);
+    return c.xx * vx * vx + 2.0 * c.xy * vx * vy + c.yy * vy * vy;
+  };
+  DOUBLES_EQUAL(floor * iso.xx, along(-20.0 * deg), 1e-9 * iso.xx);
+  DOUBLES_EQUAL(iso.xx, along(70.0 * deg), 1e-9 * iso.xx);
+  // Nothing is ever more certain than the isotropic constraint.
+  const FrameInfo odd = FrameInfo::from_directions(sigma, 0.02, 0.9, 0.3, 0.1, floor, 0.0);
+  CHECK_TRUE(odd.xx <= iso.xx * (1.0 + 1e-12) && odd.yy <= iso.yy * (1.0 + 1e-12));
+  // Not positive definite, or not finite: refused.
+  CHECK_FALSE((FrameInfo{1.0, 1.0, 1.0, 1.0}.valid()));
+  CHECK_FALSE((FrameInfo{1.0, 0.0, 1.0, 0.0}.valid()));
+  CHECK_FALSE((FrameInfo{std::nan(""), 0.0, 1.0, 1.0}.valid()));
+  rig->graph.clear();
+  CHECK_TRUE(rig->graph.add_node(Pose2{}, Pose2{}, iso));
+  CHECK_TRUE(rig->graph.add_node(Pose2{}, Pose2{}, iso));
+  CHECK_FALSE(rig->graph.add_loop(0, 1, Pose2{}, FrameInfo{1.0, 2.0, 1.0, 1.0}));
+  CHECK_FALSE(rig->graph.add_node(Pose2{}, Pose2{}, FrameInfo{-1.0, 0.0, 1.0, 1.0}));
+}
+
+// A straight corridor of 10 frames 2 m apart, consistent. A loop between its ends that
+// slid 1.5 m along the corridor and 0.3 m across it: isotropic, it stretches the chain
+// by most of the slide; as a corridor match it moves the end across, hardly along.
+TEST(FrameGraph, a_corridor_loop_pulls_across_the_corridor_not_along_it) {
+  const double sigma = 0.1;
+  const FrameInfo seg = FrameInfo::from_sigma(sigma, 0.02);
+  auto solve = [&](const FrameInfo& loop_info) {
+    rig->graph.clear();
+    for (int k = 0; k < 10; ++k) {
+      CHECK_TRUE(rig->graph.add_node(Pose2{2.0 * k, 0.0, 0.0}, k == 0 ? Pose2{} : Pose2{2.0, 0.0, 0.0}, seg));
+    }
+    CHECK_TRUE(rig->graph.add_loop(0, 9, Pose2{18.0 + 1.5, 0.3, 0.0}, loop_info, 100.0));
+    rig->graph.optimise();
+    return rig->graph.frame(9);
+  };
+  const Pose2 iso = solve(FrameInfo::from_sigma(sigma, 0.02));
+  // Normals along y: the match fixes y only.
+  const Pose2 dir = solve(FrameInfo::from_directions(sigma, 0.02, 0.0, 0.0, 1.0, 0.02, 0.0));
+  CHECK_TRUE(iso.x_m - 18.0 > 1.0);        // stretched by most of the slide
+  CHECK_TRUE(dir.x_m - 18.0 < 0.3);        // hardly
+  CHECK_TRUE(iso.y_m > 0.25 && dir.y_m > 0.25);  // across: pulled either way
 }

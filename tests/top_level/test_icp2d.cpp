@@ -1,5 +1,6 @@
 // 2D point-to-point ICP: recovery of known transforms, the mean nearest-neighbour error
-// (the paper's "ICP nearest neighbour error"), overlap and input failures.
+// (the paper's "ICP nearest neighbour error"), overlap and input failures, and the
+// direction information of a pairing (corridor vs room).
 #include <CppUTest/TestHarness.h>
 
 #include <cmath>
@@ -21,7 +22,7 @@ namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-Icp2d g_icp;  // ~40 KiB: static storage, as the header asks
+Icp2d g_icp;  // ~90 KiB: static storage, as the header asks
 Point2 g_target[cap::kMaxIcpPoints + 1];
 Point2 g_source[cap::kMaxIcpPoints + 1];
 
@@ -304,4 +305,88 @@ TEST(Icp2d, same_input_gives_bit_identical_results_across_objects) {
   CHECK_EQUAL(0, std::memcmp(&a.mean_nn_error_m, &b.mean_nn_error_m, sizeof(double)));
   LONGS_EQUAL(a.iterations, b.iterations);
   LONGS_EQUAL(a.matched_pairs, b.matched_pairs);
+}
+
+// ---- direction information (Icp2d::direction_information) --------------------------
+
+namespace {
+
+// Two parallel walls 2 m apart along `heading`, 6 m long, sampled every spacing_m.
+std::size_t corridor(Point2* out, double heading_rad, double spacing_m, double offset_m) {
+  const double c = std::cos(heading_rad), s = std::sin(heading_rad);
+  std::size_t n = 0U;
+  for (double side : {-1.0, 1.0}) {
+    for (double a = offset_m; a <= 6.0; a += spacing_m) out[n++] = Point2{c * a - s * side, s * a + c * side};
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST(Icp2d, a_corridor_match_is_fixed_across_the_corridor_only) {
+  const double heading = 30.0 * kDeg;
+  const std::size_t nt = corridor(g_target, heading, 0.05, 0.0);
+  const std::size_t ns = corridor(g_source, heading, 0.07, 0.03);
+  Icp2dOptions o;
+  o.max_correspondence_m = 0.3;
+  sdpslam::Icp2dInformation m;
+  CHECK_TRUE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 0.4, &m));
+  LONGS_EQUAL(ns, m.pairs);
+  LONGS_EQUAL(ns, m.line_pairs);
+  // Every normal is (−sin 30°, cos 30°): M = n nᵀ.
+  const double nx = -std::sin(heading), ny = std::cos(heading);
+  DOUBLES_EQUAL(nx * nx, m.xx, 1e-9);
+  DOUBLES_EQUAL(nx * ny, m.xy, 1e-9);
+  DOUBLES_EQUAL(ny * ny, m.yy, 1e-9);
+  DOUBLES_EQUAL(1.0, m.xx + m.yy, 1e-12);
+}
+
+TEST(Icp2d, a_closed_room_is_fixed_in_every_direction) {
+  // A 4 m × 3 m room: two walls of each direction, corners neither.
+  auto room = [](Point2* out, double first_m, double spacing_m) {
+    std::size_t n = 0U;
+    for (double x = first_m; x < 4.0; x += spacing_m) {
+      out[n++] = Point2{x, 0.0};
+      out[n++] = Point2{x, 3.0};
+    }
+    for (double y = first_m; y < 3.0; y += spacing_m) {
+      out[n++] = Point2{0.0, y};
+      out[n++] = Point2{4.0, y};
+    }
+    return n;
+  };
+  const std::size_t nt = room(g_target, 0.0, 0.05);
+  const std::size_t ns = room(g_source, 0.03, 0.11);
+  Icp2dOptions o;
+  o.max_correspondence_m = 0.3;
+  sdpslam::Icp2dInformation m;
+  CHECK_TRUE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 0.4, &m));
+  LONGS_EQUAL(ns, m.pairs);
+  CHECK_TRUE(m.line_pairs < ns);  // the points near the corners are not on one line
+  // Walls along x fix y (weight 2 × 4 m), walls along y fix x (2 × 3 m): both directions.
+  CHECK_TRUE(m.xx > 0.35 && m.xx < 0.5);
+  CHECK_TRUE(m.yy > 0.5 && m.yy < 0.65);
+  DOUBLES_EQUAL(0.0, m.xy, 1e-9);
+  DOUBLES_EQUAL(1.0, m.xx + m.yy, 1e-12);
+}
+
+TEST(Icp2d, direction_information_refuses_what_it_cannot_measure) {
+  const std::size_t nt = corridor(g_target, 0.0, 0.05, 0.0);
+  const std::size_t ns = corridor(g_source, 0.0, 0.07, 0.03);
+  Icp2dOptions o;
+  o.max_correspondence_m = 0.3;
+  sdpslam::Icp2dInformation m;
+  m.xx = 7.0;
+  CHECK_FALSE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 0.0, &m));   // no radius
+  CHECK_FALSE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 20.0, &m));  // > 100 cells
+  CHECK_FALSE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 0.4, nullptr));
+  CHECK_FALSE(g_icp.direction_information(nullptr, nt, g_source, ns, Pose2{}, o, 0.4, &m));
+  // Far apart: no pair.
+  CHECK_FALSE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{50.0, 0.0, 0.0}, o, 0.4, &m));
+  DOUBLES_EQUAL(7.0, m.xx, 0.0);  // untouched
+  // Lone target points (no neighbour within the radius) fix every direction: ½ I.
+  CHECK_TRUE(g_icp.direction_information(g_target, nt, g_source, ns, Pose2{}, o, 0.01, &m));
+  LONGS_EQUAL(0, m.line_pairs);
+  DOUBLES_EQUAL(0.5, m.xx, 0.0);
+  DOUBLES_EQUAL(0.5, m.yy, 0.0);
 }

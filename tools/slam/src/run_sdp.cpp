@@ -217,6 +217,8 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "segment_sigma_theta_rad") ok = real(&t.segment_sigma_theta_rad);
   else if (key == "loop_sigma_xy_m") ok = real(&t.loop_sigma_xy_m);
   else if (key == "loop_sigma_theta_rad") ok = real(&t.loop_sigma_theta_rad);
+  else if (key == "loop_normal_radius_m") ok = real(&t.loop_normal_radius_m);
+  else if (key == "loop_weak_direction_floor") ok = real(&t.loop_weak_direction_floor);
   else if (key == "loop_robust_chi") ok = real(&t.loop_robust_chi);
   else if (key == "max_loop_constraints") ok = integer(&t.max_loop_constraints);
   else if (key == "graph_iterations") ok = integer(&t.graph_iterations);

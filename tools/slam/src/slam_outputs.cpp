@@ -218,7 +218,9 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
   js += "  \"loop_closure\": {\"enabled\": " + std::string(so.loop_closure ? "true" : "false") + ", \"records\": " +
         u(st.loop_records) + ", \"refinements\": " + u(st.loop_refinements) + ", \"added\": " + u(st.loop_records_added) + ", \"dropped\": " +
         u(st.loop_records_dropped) + ", \"used_last\": " + u(st.loop_constraints_used) + ", \"downweighted_last\": " +
-        u(st.loop_downweighted) + ", \"adjustments\": " + u(st.frame_adjustments) + ", \"graph_refused\": " +
+        u(st.loop_downweighted) + ", \"weak_direction\": " + u(st.loop_constraints_weak_direction) +
+        ", \"information_unmeasured\": " + u(st.loop_information_unmeasured) +
+        ", \"adjustments\": " + u(st.frame_adjustments) + ", \"graph_refused\": " +
         u(st.frame_graph_refused) + ", \"search\": {\"window_m\": " + fmt("%.3f", so.loop_search_window_m) +
         ", \"pairs\": " + u(st.loop_searches) + ", \"weak\": " + u(st.loop_search_weak) + ", \"ambiguous\": " +
         u(st.loop_search_ambiguous) + ", \"failed\": " + u(st.loop_search_failed) + ", \"refuted\": " +

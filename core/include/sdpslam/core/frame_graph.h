@@ -42,14 +42,37 @@ struct FrameGraphOptions {
   }
 };
 
-// Diagonal information of a constraint, from standard deviations.
+// Information of a constraint, in the frame of its error e (that of Z):
+//   Ω = [ xx xy 0 ; xy yy 0 ; 0 0 theta ]
+// The translation block may be anisotropic: a match along a corridor fixes the position
+// across it far better than along it (Censi, "An accurate closed-form estimate of ICP's
+// covariance", ICRA 2007), and a constraint that claims both equally pulls a whole
+// chain along the corridor by whatever the match slid. It must be positive definite.
 struct FrameInfo {
-  double xy = 1.0;     // 1/σ_xy² (1/m²)
+  double xx = 1.0;     // (1/m²)
+  double xy = 0.0;     // (1/m²)
+  double yy = 1.0;     // (1/m²)
   double theta = 1.0;  // 1/σ_θ² (1/rad²)
   static FrameInfo from_sigma(double sigma_xy_m, double sigma_theta_rad) {
-    return FrameInfo{1.0 / (sigma_xy_m * sigma_xy_m), 1.0 / (sigma_theta_rad * sigma_theta_rad)};
+    const double t = 1.0 / (sigma_xy_m * sigma_xy_m);
+    return FrameInfo{t, 0.0, t, 1.0 / (sigma_theta_rad * sigma_theta_rad)};
   }
+  // True iff every entry is finite and the matrix is positive definite.
+  bool valid() const;
+  // A constraint measured by a match that fixes some directions better than others:
+  // `m` = [m_xx m_xy; m_xy m_yy] is the match's direction information in frame i
+  // (symmetric, trace 1: ½ I when every direction is fixed; Icp2dInformation), z_heading
+  // the heading of Z. Each eigenvector of m (eigenvalue λ) keeps
+  // clamp(2 λ, floor, 1) / σ_xy² of translation information, so a well-constrained match
+  // gives from_sigma() and a corridor keeps the across-corridor information only; the
+  // result is rotated into the frame of the error (Ω = R_zᵀ Ω_i R_z). floor in (0, 1].
+  static FrameInfo from_directions(double sigma_xy_m, double sigma_theta_rad, double m_xx, double m_xy, double m_yy,
+                                   double floor, double z_heading_rad);
 };
+
+// Eigen-decomposition of the symmetric 2×2 [a b; b c]: eigenvalues major >= minor and the
+// unit eigenvector (ux, uy) of major ((1, 0) when the two are equal).
+void symmetric2_eigen(double a, double b, double c, double* major, double* minor, double* ux, double* uy);
 
 struct FrameGraphStats {
   std::uint64_t solves = 0U;
@@ -69,11 +92,12 @@ class FrameGraph {
   // Starts a new graph (keeps the storage).
   void clear();
   // Appends node k with its current estimate; for k >= 1 also its sequential
-  // constraint: `from_previous` is the pose of frame k in frame k-1. False when full.
+  // constraint: `from_previous` is the pose of frame k in frame k-1. False when full or
+  // the information is bad.
   bool add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info);
   // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added), behind
   // a Cauchy kernel of scale robust_chi (0 = the options' scale). False when full or
-  // the indices or the scale are bad.
+  // the indices, the scale or the information (FrameInfo::valid) are bad.
   bool add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info, double robust_chi = 0.0);
   // Gauss-Newton over nodes 1 .. n-1; node 0 stays where it is.
   void optimise();

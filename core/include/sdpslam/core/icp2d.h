@@ -15,12 +15,23 @@
 // ~1° on a 5 cm grid; from 12 cm off it settles 9 cm away), and two sets made of the
 // very same regular samples can lock onto a pairing shifted by one sample.
 //
+// Direction information (direction_information(), after a match): how well a pairing
+// fixes each direction of the translation. Point-to-point residuals hide it: along a
+// straight wall a source point slides between target samples at little cost, so a match
+// in a corridor is weak along the corridor however small its error. For every pair the
+// target point's local line is fitted (principal axes of the target points within a
+// radius); a line-like neighbourhood contributes n nᵀ (n its unit normal: the
+// point-to-line constraint of Chen & Medioni 1992, whose sum is the translation block of
+// ICP's Hessian in Censi, ICRA 2007), any other ½ I (a corner or a lone point fixes both
+// directions). The mean is a symmetric 2×2 matrix of trace 1 in target coordinates:
+// eigenvalues ½ and ½ for a well-constrained match, near 1 and 0 for a corridor.
+//
 // The result carries the paper's "ICP nearest neighbour error": the mean distance, in
 // metres, between matched pairs after convergence (one final pairing pass with the
 // final transform). No overlap is not a good match: when fewer than min_pairs pairs are
 // found the status says so and mean_nn_error_m is +infinity.
 //
-// Memory: all state lives inside the Icp2d object (about 40 KiB at the default
+// Memory: all state lives inside the Icp2d object (about 90 KiB at the default
 // capacities: hash heads, chain links, pair list); put it in static storage or inside a
 // larger fixed object, not on a small stack. match() never allocates.
 // Determinism: IEEE +,-,*,/, sqrt and det::atan2/sin/cos only, fixed iteration orders,
@@ -97,6 +108,16 @@ struct Icp2dResult {
 
 const char* to_string(Icp2dResult::Status status);
 
+// Mean of the pairs' constraint directions (see the header), target coordinates:
+// [xx xy; xy yy], trace 1 when pairs > 0.
+struct Icp2dInformation {
+  double xx = 0.5;
+  double xy = 0.0;
+  double yy = 0.5;
+  std::uint32_t pairs = 0U;       // source points with a target point within reach
+  std::uint32_t line_pairs = 0U;  // ... whose target neighbourhood was line-like
+};
+
 class Icp2d {
  public:
   Icp2d() = default;
@@ -108,6 +129,16 @@ class Icp2d {
   // finite with |x|, |y| < 1e6 m. Failure conditions are exactly those of Status.
   Icp2dResult match(const Point2* target, std::size_t target_count, const Point2* source,
                     std::size_t source_count, const Pose2& initial_guess, const Icp2dOptions& options);
+
+  // Direction information of the pairing of `source`, mapped through `transform`, onto
+  // `target` (each source point with its nearest target point within max_correspondence_m
+  // of `options`); target neighbourhoods are fitted within normal_radius_m. False (and
+  // *out untouched) when an input is invalid as for match(), when normal_radius_m is not
+  // in (0, 100 × nn_cell_m], or when no pair is found. Cost: one pairing pass plus one
+  // neighbourhood search per distinct paired target point.
+  bool direction_information(const Point2* target, std::size_t target_count, const Point2* source,
+                             std::size_t source_count, const Pose2& transform, const Icp2dOptions& options,
+                             double normal_radius_m, Icp2dInformation* out);
 
   // Diagnostics over the object's lifetime (never decrease).
   std::uint32_t match_count() const { return match_count_; }
@@ -127,6 +158,10 @@ class Icp2d {
   void scan_cell(const Point2* target, std::int64_t qx, std::int64_t qy, double x_m, double y_m, std::uint32_t& best,
                  double& best_d2) const;
   std::uint32_t bucket_of(std::int64_t cx, std::int64_t cy) const;
+  // Unit normal of the target's local line at target point i (see the header), cached
+  // in normal_state_ for one direction_information() call; false when the neighbourhood
+  // is not line-like.
+  bool line_normal(const Point2* target, std::uint32_t i, double radius_m, double& nx, double& ny);
 
   std::uint32_t heads_[capacity::kIcpHashBuckets] = {};
   std::uint32_t next_[capacity::kMaxIcpPoints] = {};
@@ -134,6 +169,11 @@ class Icp2d {
   std::int32_t cell_x_[capacity::kMaxIcpPoints] = {};
   std::int32_t cell_y_[capacity::kMaxIcpPoints] = {};
   Pair pairs_[capacity::kMaxIcpPoints] = {};
+  // Per target point, during direction_information(): 0 = not fitted yet, 1 = line,
+  // 2 = not a line.
+  std::uint8_t normal_state_[capacity::kMaxIcpPoints] = {};
+  double normal_x_[capacity::kMaxIcpPoints] = {};
+  double normal_y_[capacity::kMaxIcpPoints] = {};
   double cell_m_ = 1.0;
   std::uint32_t match_count_ = 0U;
   std::uint32_t failed_match_count_ = 0U;

@@ -108,7 +108,9 @@ struct SdpOptions {
   // where the bottom level drifts little between loops: with [proposal] kind =
   // scan_match Intel's relations error is 0.07, 0.12 and 0.50 m for seeds 1, 2 and 3;
   // with the wide search below as well (profile accurate, sdp_profile.h) it is
-  // 0.060-0.113 m over seeds 1-5 (mean 0.077), and ACES's 0.068-0.088 m (mean 0.080).
+  // 0.060-0.113 m over seeds 1-5 (mean 0.077) with isotropic loop constraints and
+  // 0.061-0.083 m (mean 0.072) with direction-aware ones (below); ACES's 0.068-0.088 m
+  // (mean 0.080) and 0.070-0.116 m (mean 0.087).
   bool loop_closure = false;
   std::uint32_t loop_points = 300U;  // obstacle points per submap, 16 .. capacity::kMaxIcpPoints
   double loop_icp_max_correspondence_m = 0.3;
@@ -119,6 +121,18 @@ struct SdpOptions {
   double segment_sigma_theta_rad = 0.02;
   double loop_sigma_xy_m = 0.10;
   double loop_sigma_theta_rad = 0.02;
+  // Direction-aware loop information (icp2d.h, frame_graph.h FrameInfo): a refined match
+  // fixes the newer frame well only in the directions its wall points constrain; along a
+  // corridor it slides, by a metre and more, at a small residual. With
+  // loop_normal_radius_m > 0 the obstacle-point ICP measures the direction information M
+  // of its final pairing (point-to-line normals of the older submap's walls fitted within
+  // that radius; trace 1, ½ I when every direction is fixed) and the constraint's
+  // translation information is (1/loop_sigma_xy_m²) × clamp(2 λ, loop_weak_direction_floor, 1)
+  // along each eigenvector of M (eigenvalue λ): never more than the isotropic
+  // constraint, and in the weak direction of a corridor little more than the floor.
+  // 0 = isotropic constraints.
+  double loop_normal_radius_m = 0.4;       // [0, 2]
+  double loop_weak_direction_floor = 0.02;  // (0, 1]
   double loop_robust_chi = 3.0;
   std::uint32_t max_loop_constraints = 1024U;  // 1 .. capacity::kMaxLoopConstraints
   std::uint32_t graph_iterations = 5U;         // Gauss-Newton steps per adjustment, 1 .. 50

@@ -49,7 +49,10 @@
 // border free space, kept per submap at anchorage) refines it; a refined match with a
 // small residual and a bounded correction is kept as a constraint between the two
 // LEVELS' frames (all submaps of a level share its frame: the bottom particles restarted
-// at one pose), one per pair of levels. After every ranking, the frames of the best
+// at one pose), one per pair of levels. A constraint is only as certain as its match in
+// each direction: the refined pairing's wall normals (Icp2d::direction_information)
+// give it little information along a corridor it could slide in
+// (FrameInfo::from_directions). After every ranking, the frames of the best
 // combination — the permanent submaps still held and the chosen live submaps — are
 // adjusted by a pose graph (frame_graph.h) whose chain constraints are the transforms T
 // of Fig. 3 (l) and whose loops are those constraints. Permanent frames and the PGS
@@ -126,6 +129,8 @@ struct SdpStats {
   std::uint64_t loop_records_dropped = 0U;  // kept matches that found no room (store full)
   std::uint64_t loop_constraints_used = 0U; // in the last adjustment
   std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
+  std::uint64_t loop_constraints_weak_direction = 0U;  // loop matches weak along a direction (corridors)
+  std::uint64_t loop_information_unmeasured = 0U;      // loop matches whose direction information failed
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
@@ -265,6 +270,7 @@ class SdpSlam {
     std::uint32_t older_level = 0U;
     std::uint32_t newer_level = 0U;
     Pose2 z;
+    FrameInfo info;  // in the frame of z's error (loop_information())
     double error_m = 0.0;
     bool searched = false;  // found by the wide loop search (else by the top level's ICP)
   };
@@ -373,6 +379,13 @@ class SdpSlam {
   bool graph_index(std::uint32_t level, std::uint32_t* index) const;
   bool loop_record_dead(const LoopRecord& r) const;
   void record_loop(const LoopRecord& r);
+  // The obstacle-point ICP options of loop refinements.
+  Icp2dOptions loop_icp_options() const;
+  // The information of loop constraint z (source = newer submap's obstacle points,
+  // target = older's) from the direction information of that pairing
+  // (SdpOptions::loop_normal_radius_m), in the frame of z's error (frame_graph.h).
+  FrameInfo loop_information(const Point2* target, std::uint32_t target_count, const Point2* source,
+                             std::uint32_t source_count, const Pose2& z);
   void adjust_frames();
   // Wide loop search (loop_search_window_m > 0): one pair of submaps per call.
   void loop_search_step();
