@@ -64,6 +64,25 @@ void box_add(double b[4], double x, double y) {
 bool box_valid(const double b[4]) { return b[0] <= b[2] && b[1] <= b[3]; }
 
 // Axis-aligned bounds, in the parent frame, of box `b` given in `frame`.
+// How far apart two placements of a submap put its box's corners (m): the largest
+// corner distance. An invalid (empty) box counts its frame origin only.
+double frame_offset_m(const Pose2& a, const Pose2& b, const double box[4]) {
+  double worst = det::sqrt((a.x_m - b.x_m) * (a.x_m - b.x_m) + (a.y_m - b.y_m) * (a.y_m - b.y_m));
+  if (!box_valid(box)) return worst;
+  const double xs[2] = {box[0], box[2]};
+  const double ys[2] = {box[1], box[3]};
+  for (double x : xs) {
+    for (double y : ys) {
+      double ax = 0.0, ay = 0.0, bx = 0.0, by = 0.0;
+      a.transform_point(x, y, ax, ay);
+      b.transform_point(x, y, bx, by);
+      const double d = det::sqrt((ax - bx) * (ax - bx) + (ay - by) * (ay - by));
+      if (d > worst) worst = d;
+    }
+  }
+  return worst;
+}
+
 void box_transform(const Pose2& frame, const double b[4], double out[4]) {
   box_init(out);
   const double xs[2] = {b[0], b[2]};
@@ -509,6 +528,7 @@ void SdpSlam::make_oldest_permanent() {
   const std::uint32_t pi = (perm_head_ + perm_count_) % options_.max_permanent_submaps;
   Permanent& pm = perm_[pi];
   pm.frame_in_global = r.frame_in_global;
+  pm.frame_in_map = r.frame_in_global;  // transfer_.frame below
   pm.from_previous = had_anchor ? between(previous_frame, r.frame_in_global) : Pose2{};
   for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
   pm.level = level;
@@ -1245,11 +1265,16 @@ void SdpSlam::adjust_frames() {
   g.optimise();
   ++stats_.frame_adjustments;
   stats_.loop_downweighted = g.stats().last_downweighted;
+  double offset = 0.0;
   for (std::uint32_t k = 0; k < perm_count_; ++k) {
     Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
     pm.frame_in_global = g.frame(k);
     if (permanent_sink_ != nullptr) permanent_sink_->on_frame(pm.level, pm.frame_in_global);
+    const double d = frame_offset_m(pm.frame_in_map, pm.frame_in_global, pm.box);
+    if (d > offset) offset = d;
   }
+  stats_.permanent_map_offset_m = offset;
+  if (offset > stats_.permanent_map_offset_max_m) stats_.permanent_map_offset_max_m = offset;
   if (perm_count_ > 0U) graph_.set_anchor_frame(g.frame(perm_count_ - 1U));
   for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(perm_count_ + i);
 }

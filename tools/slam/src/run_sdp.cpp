@@ -398,6 +398,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();
     summary->icp_error_samples = st.error_samples;
+    summary->permanent_map_offset_max_m = st.permanent_map_offset_max_m;
   }
   return SdpRunStatus::kOk;
 }

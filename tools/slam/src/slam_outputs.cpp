@@ -207,7 +207,9 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
   js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
         u(st.submaps_released) + ",\n";
   js += "  \"global_map_transfers\": {\"cells\": " + u(st.map_transfer_cells) + ", \"popped\": " +
-        u(st.map_transfers_popped) + ", \"by_rows\": " + u(st.map_transfers_by_rows) + "},\n";
+        u(st.map_transfers_popped) + ", \"by_rows\": " + u(st.map_transfers_by_rows) +
+        ", \"permanent_offset_m\": " + fmt("%.3f", st.permanent_map_offset_m) +
+        ", \"permanent_offset_max_m\": " + fmt("%.3f", st.permanent_map_offset_max_m) + "},\n";
   js += "  \"icp_error\": {\"mean_m\": " + fmt("%.6f", st.error_mean_m()) + ", \"std_m\": " +
         fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
         ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +

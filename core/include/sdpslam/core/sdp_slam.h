@@ -115,6 +115,12 @@ struct SdpStats {
   std::uint64_t map_transfer_dropped = 0U;  // global-map cell updates refused (pool full)
   std::uint64_t map_transfers_popped = 0U;  // permanent submaps copied by popping (the rule)
   std::uint64_t map_transfers_by_rows = 0U; // ... by reading their rectangle (fallback)
+  // The global map's permanent part keeps the frames its submaps had when copied; loop
+  // closure may move those frames later. How far (m, at the submap's box corners) the
+  // copied map of a permanent submap lies from its adjusted frame: the largest over the
+  // ring after the last adjustment, and the largest ever seen.
+  double permanent_map_offset_m = 0.0;
+  double permanent_map_offset_max_m = 0.0;
   std::uint64_t rounds = 0U;
   std::uint64_t top_work_deferred = 0U;     // processed scans whose top-level work waited (defer_top_work)
   std::uint64_t rounds_with_overlap = 0U;
@@ -252,6 +258,7 @@ class SdpSlam {
   };
   struct Permanent {
     Pose2 frame_in_global;
+    Pose2 frame_in_map;  // the frame its map was copied into the global map node with
     Pose2 from_previous;  // this frame in the previous permanent level's frame (chain T)
     double box[4] = {0.0, 0.0, 0.0, 0.0};
     std::uint32_t level = 0U;

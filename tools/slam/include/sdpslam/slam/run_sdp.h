@@ -46,6 +46,9 @@ struct SdpRunSummary {
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
   std::uint64_t icp_error_samples = 0U;
+  // SdpStats::permanent_map_offset_max_m: how far map.pgm's permanent part may lie from
+  // the adjusted trajectory (loop corrections after the copy).
+  double permanent_map_offset_max_m = 0.0;
 };
 
 enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };
