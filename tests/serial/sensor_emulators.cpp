@@ -183,6 +183,7 @@ void UrgEmulator::tick() {
 
 void UrgEmulator::send_scan() {
   const int fault = fault_.exchange(kNone);
+  if (fault != kNone) faulted_scan_.store(static_cast<int>(scan_no_ % 1000U));
   if (fault == kGarbage) {
     std::uint8_t junk[64];
     for (auto& b : junk) b = static_cast<std::uint8_t>(xorshift(rng_));
@@ -292,6 +293,7 @@ void SickEmulator::tick() {
   if (!streaming_ || now_ms() < next_scan_ms_ || !line_ok()) return;
   next_scan_ms_ += period_ms_;
   const int fault = fault_.load() == kNakNextRequest ? kNone : fault_.exchange(kNone);
+  if (fault != kNone) faulted_scan_.store(static_cast<int>(scan_no_ % 1000U));
   std::vector<std::uint8_t> t = b0_telegram();
   if (fault == kGarbage) {
     std::uint8_t junk[48];

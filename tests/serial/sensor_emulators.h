@@ -57,6 +57,8 @@ class UrgEmulator final : public PtyDevice {
   ~UrgEmulator() override { stop(); }
   static std::uint32_t value(std::uint32_t scan, std::uint32_t i);
   void inject(Fault f) { fault_.store(f); }
+  // Id (value[0] − 1000) of the scan the last injected fault hit; −1 before one did.
+  int faulted_scan() const { return faulted_scan_.load(); }
   std::uint32_t scans_sent() const { return scans_sent_.load(); }
   std::uint32_t md_commands() const { return md_commands_.load(); }
 
@@ -74,6 +76,7 @@ class UrgEmulator final : public PtyDevice {
   std::uint64_t next_scan_ms_ = 0U;
   std::uint32_t scan_no_ = 0U;
   std::atomic<int> fault_{kNone};
+  std::atomic<int> faulted_scan_{-1};
   std::atomic<std::uint32_t> scans_sent_{0U};
   std::atomic<std::uint32_t> md_commands_{0U};
   std::uint64_t rng_ = 0x9E3779B97F4A7C15ULL;
@@ -89,6 +92,9 @@ class SickEmulator final : public PtyDevice {
   ~SickEmulator() override { stop(); }
   static std::uint16_t value(std::uint32_t scan, std::uint32_t i);  // raw word incl. flags
   void inject(Fault f) { fault_.store(f); }
+  // Id (value[0] − 1000) of the telegram the last injected fault hit (kNakNextRequest
+  // hits a request, not a telegram); −1 before one did.
+  int faulted_scan() const { return faulted_scan_.load(); }
   std::uint32_t baud() const { return baud_.load(); }
   std::uint32_t scans_sent() const { return scans_sent_.load(); }
   std::uint32_t naks_sent() const { return naks_sent_.load(); }
@@ -107,6 +113,7 @@ class SickEmulator final : public PtyDevice {
   std::uint64_t next_scan_ms_ = 0U;
   std::uint32_t scan_no_ = 0U;
   std::atomic<int> fault_{kNone};
+  std::atomic<int> faulted_scan_{-1};
   std::atomic<std::uint32_t> scans_sent_{0U};
   std::atomic<std::uint32_t> naks_sent_{0U};
   std::vector<std::uint8_t> pending_half_;

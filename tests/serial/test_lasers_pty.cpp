@@ -3,9 +3,11 @@
 // value by value against the emulator's pattern, so a corrupted scan cannot pass.
 #include <CppUTest/TestHarness.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "sdpslam/drivers/linux_clock.h"
@@ -102,6 +104,19 @@ struct Rig {
     }
     return got == count;
   }
+  // Polls until scans up to `after` past the one the injected fault hit have arrived
+  // (true), or `timeout_us` passed (false). On a loaded machine the driver falls behind
+  // the emulator, and "the next few scans" read after inject() may all predate the fault.
+  bool collect_past_fault(int after, std::int64_t timeout_us, int (*id_of)(const RangeScan&)) {
+    const std::int64_t end = clock.now_us() + timeout_us;
+    for (;;) {
+      const int f = emu.faulted_scan();
+      if (f >= 0 && !ids.empty() && ids.back() >= f + after) return true;
+      const std::int64_t left = end - clock.now_us();
+      if (left <= 0) return false;
+      collect(1, left, id_of);
+    }
+  }
 };
 
 sdpslam::drivers::UrgOptions urg_options() {
@@ -158,7 +173,7 @@ TEST(UrgLaserPty, corrupted_data_byte_drops_exactly_that_scan_as_checksum_error)
   UrgRig rig("urgcs", 115200U, urg_options());
   CHECK(rig.collect(3, 3000000, urg_scan_id));
   rig.emu.inject(UrgEmulator::kCorruptData);
-  CHECK(rig.collect(5, 3000000, urg_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
@@ -170,7 +185,7 @@ TEST(UrgLaserPty, truncated_line_drops_exactly_that_scan) {
   UrgRig rig("urgtr", 115200U, urg_options());
   CHECK(rig.collect(3, 3000000, urg_scan_id));
   rig.emu.inject(UrgEmulator::kTruncateLine);
-  CHECK(rig.collect(5, 3000000, urg_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
@@ -182,7 +197,7 @@ TEST(UrgLaserPty, lost_data_line_is_a_value_count_framing_error) {
   UrgRig rig("urglost", 115200U, urg_options());
   CHECK(rig.collect(3, 3000000, urg_scan_id));
   rig.emu.inject(UrgEmulator::kDropLine);
-  CHECK(rig.collect(5, 3000000, urg_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
@@ -195,13 +210,27 @@ TEST(UrgLaserPty, random_garbage_is_skipped_and_streaming_resumes_at_the_next_re
   UrgRig rig("urggb", 115200U, urg_options());
   CHECK(rig.collect(3, 3000000, urg_scan_id));
   rig.emu.inject(UrgEmulator::kGarbage);
-  CHECK(rig.collect(5, 3000000, urg_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, urg_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   CHECK(missing(rig.ids) <= 1);  // garbage glued to the next echo costs that scan
   CHECK(rig.laser.stats().garbage_byte_count > 0);
   CHECK(rig.laser.stats().resync_count >= 1);
   LONGS_EQUAL(static_cast<long>(missing(rig.ids)), static_cast<long>(rig.laser.stats().dropped_scan_count));
+}
+
+// A poll held off longer than the stall timeout (a loaded machine, a long SLAM step)
+// finds scans waiting in the tty: it reads them, it does not call the sensor stalled.
+TEST(UrgLaserPty, a_poll_held_off_past_the_stall_timeout_reads_the_backlog_without_a_restart) {
+  UrgRig rig("urghold", 115200U, urg_options());
+  CHECK(rig.collect(3, 3000000, urg_scan_id));
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // stall_timeout_us is 400 ms
+  CHECK(rig.collect(10, 3000000, urg_scan_id));
+  LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());
+  LONGS_EQUAL(0, rig.laser.stats().stall_count);
+  LONGS_EQUAL(0, rig.laser.stats().restart_count);
+  LONGS_EQUAL(0, missing(rig.ids));
 }
 
 TEST(UrgLaserPty, unplug_is_seen_as_hangup_and_replug_restarts_streaming) {
@@ -247,7 +276,7 @@ TEST(SickLaserPty, corrupted_telegram_fails_crc_and_only_that_scan_is_lost) {
   SickRig rig("sickcrc", 9600U, sick_options(38400U));
   CHECK(rig.collect(3, 3000000, sick_scan_id));
   rig.emu.inject(SickEmulator::kCorruptCrc);
-  CHECK(rig.collect(5, 3000000, sick_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
@@ -259,7 +288,7 @@ TEST(SickLaserPty, truncated_telegram_is_lost_and_the_next_one_is_recovered_by_r
   SickRig rig("sicktr", 9600U, sick_options(38400U));
   CHECK(rig.collect(3, 3000000, sick_scan_id));
   rig.emu.inject(SickEmulator::kTruncateTelegram);
-  CHECK(rig.collect(5, 3000000, sick_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(1, missing(rig.ids));
@@ -271,12 +300,24 @@ TEST(SickLaserPty, garbage_with_false_stx_bytes_costs_no_scan) {
   SickRig rig("sickgb", 9600U, sick_options(38400U));
   CHECK(rig.collect(3, 3000000, sick_scan_id));
   rig.emu.inject(SickEmulator::kGarbage);
-  CHECK(rig.collect(5, 3000000, sick_scan_id));
+  CHECK(rig.collect_past_fault(3, 6000000, sick_scan_id));
   LONGS_EQUAL(0, rig.bad);
   LONGS_EQUAL(0, rig.emu.sends_cut());  // every loss below is the injected fault's
   LONGS_EQUAL(0, missing(rig.ids));
   CHECK(rig.laser.stats().garbage_byte_count >= 40);
   CHECK(rig.laser.stats().resync_count >= 1);
+}
+
+TEST(SickLaserPty, a_poll_held_off_past_the_stall_timeout_reads_the_backlog_without_a_restart) {
+  SickRig rig("sickhold", 9600U, sick_options(38400U));
+  CHECK(rig.collect(3, 3000000, sick_scan_id));
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // stall_timeout_us is 400 ms
+  CHECK(rig.collect(10, 3000000, sick_scan_id));
+  LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());
+  LONGS_EQUAL(0, rig.laser.stats().stall_count);
+  LONGS_EQUAL(0, rig.laser.stats().restart_count);
+  LONGS_EQUAL(0, missing(rig.ids));
 }
 
 TEST(SickLaserPty, nak_is_counted_and_the_request_is_resent) {

@@ -200,16 +200,6 @@ int SickLms2xxLaser::poll(RangeScan& out, std::int64_t timeout_us) {
     }
     sync_parser_stats();
     now = clock_.now_us();
-    if (awaiting_ && now >= step_deadline_us_) {
-      ++stats_.timeout_count;
-      retry_or_restart(now, true);
-    }
-    if (step_ == Step::kStreaming && now - last_scan_us_ >= options_.stall_timeout_us) {
-      ++stats_.stall_count;
-      ++stats_.restart_count;
-      begin_sequence(now);
-      health_ = hal::RangeSourceHealth::kStalled;
-    }
     if (!awaiting_ && step_ != Step::kStreaming) send_step(now);
     const std::int32_t n = stream_.read(rx_, sizeof rx_);
     if (n > 0) {
@@ -218,6 +208,22 @@ int SickLms2xxLaser::poll(RangeScan& out, std::int64_t timeout_us) {
       continue;
     }
     if (n < 0) continue;
+    // Nothing is pending: only now may silence count as a reply timeout or a stall. A
+    // poll that was held off (a loaded machine, a long SLAM step) reads its backlog
+    // first; judged before that, a healthy sensor would be restarted and its buffered
+    // scans thrown away.
+    if (awaiting_ && now >= step_deadline_us_) {
+      ++stats_.timeout_count;
+      retry_or_restart(now, true);
+      continue;
+    }
+    if (step_ == Step::kStreaming && now - last_scan_us_ >= options_.stall_timeout_us) {
+      ++stats_.stall_count;
+      ++stats_.restart_count;
+      begin_sequence(now);
+      health_ = hal::RangeSourceHealth::kStalled;
+      continue;
+    }
     if (now >= deadline) return 0;
     std::int64_t wake = deadline;
     if (awaiting_ && step_deadline_us_ < wake) wake = step_deadline_us_;

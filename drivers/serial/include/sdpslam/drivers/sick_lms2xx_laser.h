@@ -30,7 +30,7 @@ struct SickOptions {
   std::uint16_t angle_deg = 180U;      // 100 or 180
   std::uint16_t resolution_cdeg = 50U;  // 25, 50, 100 (1/100 deg)
   std::int64_t reply_timeout_us = 1000000;
-  std::int64_t stall_timeout_us = 500000;
+  std::int64_t stall_timeout_us = 500000;  // no scan for this long while streaming, with nothing left to read
   std::uint32_t max_retries = 3U;
   Pose2 laser_in_base;
 };

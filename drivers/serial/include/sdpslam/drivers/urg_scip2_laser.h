@@ -25,7 +25,7 @@ namespace sdpslam::drivers {
 
 struct UrgOptions {
   std::int64_t reply_timeout_us = 1000000;
-  std::int64_t stall_timeout_us = 1000000;  // no scan for this long while streaming
+  std::int64_t stall_timeout_us = 1000000;  // no scan for this long while streaming, with nothing left to read
   std::uint32_t max_retries = 3U;
   std::uint32_t cluster = 1U;  // steps merged per beam (1..99)
   Pose2 laser_in_base;
