@@ -74,34 +74,11 @@ double dot(const double* a, const double* b, std::size_t n) {
 
 }  // namespace
 
-// λ± = (a+c)/2 ± sqrt(((a−c)/2)² + b²); the eigenvector of λ+ is (b, λ+ − a) or
-// (λ+ − c, b), whichever is longer (the other may vanish).
-void symmetric2_eigen(double a, double b, double c, double* major, double* minor, double* ux, double* uy) {
-  const double half_diff = 0.5 * (a - c);
-  const double root = det::sqrt(half_diff * half_diff + b * b);
-  *major = 0.5 * (a + c) + root;
-  *minor = 0.5 * (a + c) - root;
-  double x = b, y = *major - a;
-  const double x2 = *major - c, y2 = b;
-  if (x2 * x2 + y2 * y2 > x * x + y * y) {
-    x = x2;
-    y = y2;
-  }
-  const double norm = det::sqrt(x * x + y * y);
-  if (norm > 0.0) {
-    *ux = x / norm;
-    *uy = y / norm;
-  } else {
-    *ux = 1.0;
-    *uy = 0.0;
-  }
-}
-
 FrameInfo FrameInfo::from_directions(double sigma_xy_m, double sigma_theta_rad, double m_xx, double m_xy,
                                      double m_yy, double floor, double z_heading_rad) {
   const FrameInfo iso = from_sigma(sigma_xy_m, sigma_theta_rad);
   double major = 0.0, minor = 0.0, ux = 1.0, uy = 0.0;
-  symmetric2_eigen(m_xx, m_xy, m_yy, &major, &minor, &ux, &uy);
+  det::symmetric2_eigen(m_xx, m_xy, m_yy, &major, &minor, &ux, &uy);
   auto share = [floor](double lambda) {
     const double k = 2.0 * lambda;
     if (!(k > floor)) return floor;  // NaN too
@@ -241,13 +218,12 @@ void FrameGraph::multiply(const double* v, double* out) const {
     }
     double wjv[3];
     weighted(c.info, l.w, jv, wjv);
-    for (int r = 0; r < 3; ++r) jv[r] = wjv[r];
     if (c.i != 0U) {
-      mat_t_vec(l.a, jv, t);
+      mat_t_vec(l.a, wjv, t);
       for (int r = 0; r < 3; ++r) out[3U * c.i + static_cast<std::uint32_t>(r)] += t[r];
     }
     if (c.j != 0U) {
-      mat_t_vec(l.b, jv, t);
+      mat_t_vec(l.b, wjv, t);
       for (int r = 0; r < 3; ++r) out[3U * c.j + static_cast<std::uint32_t>(r)] += t[r];
     }
   };

@@ -5,7 +5,6 @@
 #include <limits>
 
 #include "sdpslam/core/det_math.h"
-#include "sdpslam/core/frame_graph.h"  // symmetric2_eigen
 
 namespace sdpslam {
 namespace {
@@ -259,7 +258,7 @@ Icp2dResult Icp2d::match(const Point2* target, std::size_t target_count, const P
 // Principal axes of the target points within radius_m of target[i] (itself included):
 // covariance C = [a b; b c], eigenvalues λ± = (a+c)/2 ± sqrt(((a−c)/2)² + b²). Line-like
 // when there are at least 3 points and λ− <= kLineRatio λ+; the normal is then
-// perpendicular to the eigenvector of λ+ (symmetric2_eigen).
+// perpendicular to the eigenvector of λ+ (det::symmetric2_eigen).
 bool Icp2d::line_normal(const Point2* target, std::uint32_t i, double radius_m, double& nx, double& ny) {
   constexpr double kLineRatio = 0.1;
   if (normal_state_[i] != 0U) {
@@ -306,7 +305,7 @@ bool Icp2d::line_normal(const Point2* target, std::uint32_t i, double radius_m, 
     c += v * v;
   });
   double major = 0.0, minor = 0.0, ux = 1.0, uy = 0.0;
-  symmetric2_eigen(a, b, c, &major, &minor, &ux, &uy);
+  det::symmetric2_eigen(a, b, c, &major, &minor, &ux, &uy);
   if (!(major > 0.0) || minor > kLineRatio * major) return false;
   nx = -uy;
   ny = ux;

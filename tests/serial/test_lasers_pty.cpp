@@ -136,6 +136,20 @@ sdpslam::drivers::SickOptions sick_options(std::uint32_t baud) {
 using UrgRig = Rig<UrgEmulator, sdpslam::drivers::UrgScip2Laser, sdpslam::drivers::UrgOptions>;
 using SickRig = Rig<SickEmulator, sdpslam::drivers::SickLms2xxLaser, sdpslam::drivers::SickOptions>;
 
+// A poll held off longer than the stall timeout (a loaded machine, a long SLAM step)
+// finds scans waiting in the tty: it reads them, it does not call the sensor stalled.
+template <typename R>
+void check_held_off_poll_reads_backlog(R& rig, int (*id_of)(const RangeScan&)) {
+  CHECK(rig.collect(3, 3000000, id_of));
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // stall_timeout_us is 400 ms
+  CHECK(rig.collect(10, 3000000, id_of));
+  LONGS_EQUAL(0, rig.bad);
+  LONGS_EQUAL(0, rig.emu.sends_cut());
+  LONGS_EQUAL(0, rig.laser.stats().stall_count);
+  LONGS_EQUAL(0, rig.laser.stats().restart_count);
+  LONGS_EQUAL(0, missing(rig.ids));
+}
+
 }  // namespace
 
 TEST_GROUP(UrgLaserPty) {};
@@ -219,18 +233,9 @@ TEST(UrgLaserPty, random_garbage_is_skipped_and_streaming_resumes_at_the_next_re
   LONGS_EQUAL(static_cast<long>(missing(rig.ids)), static_cast<long>(rig.laser.stats().dropped_scan_count));
 }
 
-// A poll held off longer than the stall timeout (a loaded machine, a long SLAM step)
-// finds scans waiting in the tty: it reads them, it does not call the sensor stalled.
 TEST(UrgLaserPty, a_poll_held_off_past_the_stall_timeout_reads_the_backlog_without_a_restart) {
   UrgRig rig("urghold", 115200U, urg_options());
-  CHECK(rig.collect(3, 3000000, urg_scan_id));
-  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // stall_timeout_us is 400 ms
-  CHECK(rig.collect(10, 3000000, urg_scan_id));
-  LONGS_EQUAL(0, rig.bad);
-  LONGS_EQUAL(0, rig.emu.sends_cut());
-  LONGS_EQUAL(0, rig.laser.stats().stall_count);
-  LONGS_EQUAL(0, rig.laser.stats().restart_count);
-  LONGS_EQUAL(0, missing(rig.ids));
+  check_held_off_poll_reads_backlog(rig, urg_scan_id);
 }
 
 TEST(UrgLaserPty, unplug_is_seen_as_hangup_and_replug_restarts_streaming) {
@@ -310,14 +315,7 @@ TEST(SickLaserPty, garbage_with_false_stx_bytes_costs_no_scan) {
 
 TEST(SickLaserPty, a_poll_held_off_past_the_stall_timeout_reads_the_backlog_without_a_restart) {
   SickRig rig("sickhold", 9600U, sick_options(38400U));
-  CHECK(rig.collect(3, 3000000, sick_scan_id));
-  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // stall_timeout_us is 400 ms
-  CHECK(rig.collect(10, 3000000, sick_scan_id));
-  LONGS_EQUAL(0, rig.bad);
-  LONGS_EQUAL(0, rig.emu.sends_cut());
-  LONGS_EQUAL(0, rig.laser.stats().stall_count);
-  LONGS_EQUAL(0, rig.laser.stats().restart_count);
-  LONGS_EQUAL(0, missing(rig.ids));
+  check_held_off_poll_reads_backlog(rig, sick_scan_id);
 }
 
 TEST(SickLaserPty, nak_is_counted_and_the_request_is_resent) {

@@ -268,4 +268,29 @@ inline double wrap_angle(double a) {
   return a;
 }
 
+// Eigen-decomposition of the symmetric 2×2 [a b; b c]: eigenvalues major >= minor and the
+// unit eigenvector (ux, uy) of major ((1, 0) when the two are equal).
+// λ± = (a+c)/2 ± sqrt(((a−c)/2)² + b²); the eigenvector of λ+ is (b, λ+ − a) or
+// (λ+ − c, b), whichever is longer (the other may vanish).
+inline void symmetric2_eigen(double a, double b, double c, double* major, double* minor, double* ux, double* uy) {
+  const double half_diff = 0.5 * (a - c);
+  const double root = sqrt(half_diff * half_diff + b * b);
+  *major = 0.5 * (a + c) + root;
+  *minor = 0.5 * (a + c) - root;
+  double x = b, y = *major - a;
+  const double x2 = *major - c, y2 = b;
+  if (x2 * x2 + y2 * y2 > x * x + y * y) {
+    x = x2;
+    y = y2;
+  }
+  const double norm = sqrt(x * x + y * y);
+  if (norm > 0.0) {
+    *ux = x / norm;
+    *uy = y / norm;
+  } else {
+    *ux = 1.0;
+    *uy = 0.0;
+  }
+}
+
 }  // namespace sdpslam::det

@@ -70,9 +70,6 @@ struct FrameInfo {
                                    double floor, double z_heading_rad);
 };
 
-// Eigen-decomposition of the symmetric 2×2 [a b; b c]: eigenvalues major >= minor and the
-// unit eigenvector (ux, uy) of major ((1, 0) when the two are equal).
-void symmetric2_eigen(double a, double b, double c, double* major, double* minor, double* ux, double* uy);
 
 struct FrameGraphStats {
   std::uint64_t solves = 0U;
