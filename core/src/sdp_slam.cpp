@@ -1329,6 +1329,7 @@ void SdpSlam::loop_search_step() {
 void SdpSlam::loop_search_collect(std::uint32_t newer) {
   search_count_ = 0U;
   search_cursor_ = 0U;
+  search_held_count_ = 0U;  // a held peak waits for its own level's other pairs only
   const CellPoint* pts = nullptr;
   std::uint32_t n = 0U;
   Pose2 frame;
@@ -1399,7 +1400,7 @@ void SdpSlam::loop_search_pair(std::uint32_t older, std::uint32_t newer) {
   co.kernel_sigma_m = 1.5 * co.resolution_m;
   co.window_xy_m = options_.loop_search_window_m;
   co.window_theta_rad = options_.loop_search_window_rad;
-  co.min_score = options_.loop_search_min_score;
+  co.min_score = options_.loop_search_confirm_score;  // loop_search_continue() holds those below min_score
   co.max_ambiguity = options_.loop_search_max_ambiguity;
   if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
     ++stats_.loop_search_failed;
@@ -1440,7 +1441,6 @@ void SdpSlam::loop_search_continue() {
     ++stats_.loop_search_refuted;
     return;
   }
-  ++stats_.loop_search_closed;
   LoopRecord lr;
   lr.older_level = search_pair_older_;
   lr.newer_level = search_pair_newer_;
@@ -1448,8 +1448,56 @@ void SdpSlam::loop_search_continue() {
   lr.error_m = f.mean_nn_error_m;
   lr.info = loop_information(search_a_, search_a_count_, search_b_, search_b_count_, f.transform);
   lr.searched = true;
-  record_loop(lr);
-  if (!loop_record_dead(lr)) update_best();  // the frames follow the new constraint now
+  // Held peaks this one agrees with are corroborated by it (whether it is held or not).
+  bool agreed = false;
+  std::uint32_t kept = 0U;
+  for (std::uint32_t k = 0; k < search_held_count_; ++k) {
+    if (loops_agree(search_held_[k], lr)) {
+      ++stats_.loop_search_corroborated;
+      loop_search_accept(search_held_[k]);
+      agreed = true;
+    } else {
+      search_held_[kept++] = search_held_[k];
+    }
+  }
+  search_held_count_ = kept;
+  if (c.score < options_.loop_search_min_score) {
+    ++stats_.loop_search_held;
+    for (std::uint32_t k = 0; k < loop_count_ && !agreed; ++k) {
+      agreed = loops_[k].newer_level == lr.newer_level && loops_agree(loops_[k], lr);
+    }
+    if (!agreed) {
+      if (search_held_count_ < SdpOptions::kMaxLoopSearchCandidates) search_held_[search_held_count_++] = lr;
+      return;
+    }
+    ++stats_.loop_search_corroborated;
+  }
+  loop_search_accept(lr);
+}
+
+void SdpSlam::loop_search_accept(const LoopRecord& r) {
+  ++stats_.loop_search_closed;
+  record_loop(r);
+  if (!loop_record_dead(r)) update_best();  // the frames follow the new constraint now
+}
+
+// Two matches of the same newer submap against different older ones agree when they
+// place it alike in the best combination's frame (each older submap where the frames
+// put it now).
+bool SdpSlam::loops_agree(const LoopRecord& a, const LoopRecord& b) const {
+  if (a.newer_level != b.newer_level || a.older_level == b.older_level) return false;
+  const CellPoint* pts = nullptr;
+  std::uint32_t n = 0U;
+  Pose2 fa;
+  Pose2 fb;
+  double box[4];
+  if (!level_obstacles(a.older_level, &pts, &n, &fa, box) || !level_obstacles(b.older_level, &pts, &n, &fb, box)) {
+    return false;
+  }
+  const Pose2 d = between(fa.compose(a.z), fb.compose(b.z));
+  const double xy = options_.loop_search_confirm_xy_m;
+  const double th = normalize_angle_rad(d.heading_rad);
+  return d.x_m * d.x_m + d.y_m * d.y_m <= xy * xy && (th < 0.0 ? -th : th) <= options_.loop_search_confirm_rad;
 }
 
 }  // namespace sdpslam

@@ -140,11 +140,13 @@ struct SdpStats {
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
-  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored too low
+  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_confirm_score
   std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
   std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
   std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
-  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints
+  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints (held ones included)
+  std::uint64_t loop_search_held = 0U;      // ... scoring confirm_score .. min_score, held for a second match
+  std::uint64_t loop_search_corroborated = 0U;  // held ones another pair agreed with (constraints now)
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
   std::uint32_t max_live_levels = 0U;
@@ -399,6 +401,8 @@ class SdpSlam {
   void loop_search_collect(std::uint32_t newer_level);
   void loop_search_pair(std::uint32_t older_level, std::uint32_t newer_level);
   void loop_search_continue();
+  bool loops_agree(const LoopRecord& a, const LoopRecord& b) const;
+  void loop_search_accept(const LoopRecord& r);
   // Obstacle points and global frame of a level in the best combination (permanent or
   // live); false if the level is no longer held.
   bool level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
@@ -464,6 +468,9 @@ class SdpSlam {
   std::uint32_t search_b_count_ = 0U;
   std::uint32_t search_pair_older_ = 0U;
   std::uint32_t search_pair_newer_ = 0U;
+  // Weak peaks of the level being searched, waiting for a second pair to agree.
+  LoopRecord search_held_[SdpOptions::kMaxLoopSearchCandidates] = {};
+  std::uint32_t search_held_count_ = 0U;
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N
