@@ -166,7 +166,8 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
              2U * Arena::bytes_for<Point2>(s.loop_points);
     if (s.loop_search_window_m > 0.0) {
       total += CorrelativeMatcher::required_bytes(search_grid_side(cs), s.loop_points, search_steps(b, s)) +
-               2U * Arena::bytes_for<Point2>(s.loop_points);
+               2U * Arena::bytes_for<Point2>(s.loop_points) +
+               Arena::bytes_for<std::uint32_t>(std::size_t{s.max_permanent_submaps} + L);
     }
   }
   total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
@@ -250,7 +251,8 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     if (s.loop_search_window_m > 0.0) {
       search_a_ = arena.allocate_array<Point2>(s.loop_points);
       search_b_ = arena.allocate_array<Point2>(s.loop_points);
-      if (search_a_ == nullptr || search_b_ == nullptr) {
+      hops_ = arena.allocate_array<std::uint32_t>(std::size_t{s.max_permanent_submaps} + L);
+      if (search_a_ == nullptr || search_b_ == nullptr || hops_ == nullptr) {
         std::snprintf(why_, sizeof why_, "arena exhausted (loop search)");
         return false;
       }
@@ -1461,8 +1463,10 @@ void SdpSlam::loop_search_continue() {
     }
   }
   search_held_count_ = kept;
-  if (c.score < options_.loop_search_min_score) {
+  const bool far = options_.loop_search_drift_m > 0.0 && loop_moves_too_far(lr);
+  if (c.score < options_.loop_search_min_score || far) {
     ++stats_.loop_search_held;
+    if (far) ++stats_.loop_search_far;
     for (std::uint32_t k = 0; k < loop_count_ && !agreed; ++k) {
       agreed = loops_[k].newer_level == lr.newer_level && loops_agree(loops_[k], lr);
     }
@@ -1498,6 +1502,71 @@ bool SdpSlam::loops_agree(const LoopRecord& a, const LoopRecord& b) const {
   const double xy = options_.loop_search_confirm_xy_m;
   const double th = normalize_angle_rad(d.heading_rad);
   return d.x_m * d.x_m + d.y_m * d.y_m <= xy * xy && (th < 0.0 ? -th : th) <= options_.loop_search_confirm_rad;
+}
+
+// Whether r would move its newer submap (the centre of its box) farther from where the
+// best combination's frames put it now than the chain may have drifted between the two
+// levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
+bool SdpSlam::loop_moves_too_far(const LoopRecord& r) const {
+  const CellPoint* pts = nullptr;
+  std::uint32_t n = 0U;
+  Pose2 fo;
+  Pose2 fn;
+  double ob[4];
+  double nb[4];
+  if (!level_obstacles(r.older_level, &pts, &n, &fo, ob) || !level_obstacles(r.newer_level, &pts, &n, &fn, nb) ||
+      !box_valid(nb)) {
+    return false;
+  }
+  const Pose2 centre{0.5 * (nb[0] + nb[2]), 0.5 * (nb[1] + nb[3]), 0.0};
+  const Pose2 now = fn.compose(centre);
+  const Pose2 moved = fo.compose(r.z).compose(centre);
+  const double dx = moved.x_m - now.x_m;
+  const double dy = moved.y_m - now.y_m;
+  const double limit_m2 = options_.loop_search_drift_m * options_.loop_search_drift_m *
+                          static_cast<double>(level_hops(r.older_level, r.newer_level));
+  return dx * dx + dy * dy > limit_m2;
+}
+
+// The fewest steps between two levels over the frame graph's nodes: chain steps between
+// consecutive levels, one step across each loop record both of whose levels are held
+// (other than one of this same pair).
+// Bounded work: at most kHopPasses rounds of relaxation (more would only shorten a
+// path that already crosses that many loops); the level gap if either is not held.
+std::uint32_t SdpSlam::level_hops(std::uint32_t older_level, std::uint32_t newer_level) const {
+  constexpr std::uint32_t kHopPasses = 8U;
+  const std::uint32_t gap = newer_level > older_level ? newer_level - older_level : older_level - newer_level;
+  std::uint32_t a = 0U;
+  std::uint32_t b = 0U;
+  if (hops_ == nullptr || !graph_index(older_level, &a) || !graph_index(newer_level, &b)) return gap;
+  const std::uint32_t n = perm_count_ + graph_.live_level_count();
+  for (std::uint32_t i = 0; i < n; ++i) hops_[i] = i > a ? i - a : a - i;
+  for (std::uint32_t pass = 0; pass < kHopPasses; ++pass) {
+    bool changed = false;
+    for (std::uint32_t k = 0; k < loop_count_; ++k) {
+      const LoopRecord& r = loops_[k];
+      // A record of the same pair is a rival estimate of this very constraint, not a path.
+      if (r.older_level == older_level && r.newer_level == newer_level) continue;
+      std::uint32_t u = 0U;
+      std::uint32_t v = 0U;
+      if (!graph_index(r.older_level, &u) || !graph_index(r.newer_level, &v)) continue;
+      if (hops_[u] + 1U < hops_[v]) {
+        hops_[v] = hops_[u] + 1U;
+        changed = true;
+      } else if (hops_[v] + 1U < hops_[u]) {
+        hops_[u] = hops_[v] + 1U;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+    for (std::uint32_t i = 1; i < n; ++i) {
+      if (hops_[i - 1U] + 1U < hops_[i]) hops_[i] = hops_[i - 1U] + 1U;
+    }
+    for (std::uint32_t i = n - 1U; i > 0U; --i) {
+      if (hops_[i] + 1U < hops_[i - 1U]) hops_[i - 1U] = hops_[i] + 1U;
+    }
+  }
+  return hops_[b];
 }
 
 }  // namespace sdpslam

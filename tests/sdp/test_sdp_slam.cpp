@@ -272,6 +272,49 @@ TEST(SdpSlam, weak_search_peaks_close_loops_only_when_a_second_older_submap_agre
   LONGS_EQUAL(0, c.loop_search_corroborated);
 }
 
+// A peak that would move its newer submap farther than the chain can have drifted
+// (loop_search_drift_m × √hops) is held like a weak one: with no drift allowed every
+// closure needs a second older submap's agreement; with the gate off nothing is held
+// for its shift.
+TEST(SdpSlam, far_search_peaks_close_loops_only_when_a_second_older_submap_agrees) {
+  const test::ScanSet set(3);
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  s.loop_search_window_m = 3.0;
+  auto run = [&](const SdpOptions& o, double* error_m) {
+    test::SdpRig r;
+    CHECK_TRUE(r.init(test::sim_options(5), o, 21));
+    test::CollectPoses sink;
+    const Trace t = run_sdp(r, set, &sink);
+    *error_m = mean_error_to_truth(t, set);
+    CHECK_TRUE(r.slam->graph().invariants_hold());
+    const SdpStats st = r.slam->stats();
+    LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
+                                      st.loop_search_refuted + st.loop_search_closed +
+                                      (st.loop_search_held - st.loop_search_corroborated));
+    CHECK(st.loop_search_far <= st.loop_search_held);
+    return st;
+  };
+  SdpOptions none = s;
+  none.loop_search_drift_m = 1.0e-9;
+  double none_m = 0.0;
+  const SdpStats a = run(none, &none_m);
+  CHECK(a.loop_search_far > 0U);
+  LONGS_EQUAL(a.loop_search_corroborated, a.loop_search_closed);
+  SdpOptions off = s;
+  off.loop_search_drift_m = 0.0;
+  double off_m = 0.0;
+  const SdpStats b = run(off, &off_m);
+  LONGS_EQUAL(0, b.loop_search_far);
+  CHECK(b.loop_search_closed > b.loop_search_corroborated);
+  double default_m = 0.0;
+  const SdpStats c = run(s, &default_m);
+  std::printf("\n  far search peaks: %llu far of %llu held, mean position error %.3f m (no drift allowed %.3f m, "
+              "gate off %.3f m)\n",
+              static_cast<unsigned long long>(c.loop_search_far), static_cast<unsigned long long>(c.loop_search_held),
+              default_m, none_m, off_m);
+}
+
 // Worst-scan time: a skeleton patch is read from the DP map in strips of coarse rows
 // within the per-scan budget (reading a cell costs microseconds), not in one go.
 TEST(SdpSlam, skeleton_work_per_scan_stays_within_the_budget) {

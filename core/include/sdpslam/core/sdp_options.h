@@ -165,6 +165,18 @@ struct SdpOptions {
   double loop_search_confirm_score = 0.40;     // (0, loop_search_min_score]
   double loop_search_confirm_xy_m = 0.30;      // [0, 10]
   double loop_search_confirm_rad = 0.05;       // [0, pi]
+  // A lone peak (however well it scores) that would move the newer submap (its box
+  // centre, from where the best combination's frames put it now) farther than
+  // loop_search_drift_m × √hops is held the same way until a second older submap agrees;
+  // hops = the fewest steps between the two levels along the chain and the other loop
+  // constraints already recorded (the chain drifts like a random walk; a recorded loop is
+  // a short cut). Repeated structure matches metres off: on Intel and ACES, peaks 6 m
+  // off two levels apart (4 m per √hop) were accepted, and Intel seed 10's 5.8 m jump over 6 hops
+  // (2.4 m per √hop) pulled the map apart (relations error 0.118 m, 0.065 m held). True
+  // loops, measured over 20 runs, moved their submap at most 1.8 m per √hop (ACES' first
+  // loops, 7 m over 15-21 hops). With 2.0, seeds 1-10: Intel 0.059-0.081 m (mean 0.067,
+  // was 0.077), ACES 0.065-0.097 m (mean 0.080, unchanged). 0: off.
+  double loop_search_drift_m = 2.0;            // [0, 100]
   std::uint32_t loop_search_candidates = 4U;   // 1 .. kMaxLoopSearchCandidates
   // Cauchy scale on the constraints the search found (loop_robust_chi is for the top
   // level's), for two submaps 10 levels apart; it grows with the square root of the

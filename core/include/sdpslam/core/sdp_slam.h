@@ -145,7 +145,8 @@ struct SdpStats {
   std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
   std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
   std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints (held ones included)
-  std::uint64_t loop_search_held = 0U;      // ... scoring confirm_score .. min_score, held for a second match
+  std::uint64_t loop_search_held = 0U;      // ... held for a second match (scoring confirm_score .. min_score, or far)
+  std::uint64_t loop_search_far = 0U;       // held ones that would move their submap beyond loop_search_drift_m × √hops
   std::uint64_t loop_search_corroborated = 0U;  // held ones another pair agreed with (constraints now)
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
@@ -402,6 +403,8 @@ class SdpSlam {
   void loop_search_pair(std::uint32_t older_level, std::uint32_t newer_level);
   void loop_search_continue();
   bool loops_agree(const LoopRecord& a, const LoopRecord& b) const;
+  bool loop_moves_too_far(const LoopRecord& r) const;
+  std::uint32_t level_hops(std::uint32_t older_level, std::uint32_t newer_level) const;
   void loop_search_accept(const LoopRecord& r);
   // Obstacle points and global frame of a level in the best combination (permanent or
   // live); false if the level is no longer held.
@@ -471,6 +474,7 @@ class SdpSlam {
   // Weak peaks of the level being searched, waiting for a second pair to agree.
   LoopRecord search_held_[SdpOptions::kMaxLoopSearchCandidates] = {};
   std::uint32_t search_held_count_ = 0U;
+  std::uint32_t* hops_ = nullptr;  // max_permanent_submaps + max_levels (level_hops() scratch)
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N
