@@ -47,6 +47,8 @@ std::size_t pool_bytes(std::uint32_t capacity) {
 
 }  // namespace
 
+std::int32_t DpMap::cells_along(double extent_m, double resolution_m) { return cells_for(extent_m, resolution_m); }
+
 std::size_t DpMap::index_slots_for(std::uint32_t observation_capacity) {
   const std::size_t want = static_cast<std::size_t>(observation_capacity) + observation_capacity / 2U + 1U;
   std::size_t slots = 2U;

@@ -318,12 +318,4 @@ bool DpSlamFilter::pop_anchored_observation(NodeId node, std::int32_t* ix, std::
   return map_.pop_observation(node, ix, iy, value);
 }
 
-NodeId DpSlamFilter::create_anchored_root() { return initialised_ ? tree_.create_root() : kNoNode; }
-
-bool DpSlamFilter::add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits,
-                                   std::uint16_t misses) {
-  if (is_particle_node(node)) return false;
-  return map_.add(node, ix, iy, hits, misses);
-}
-
 }  // namespace sdpslam

@@ -125,7 +125,7 @@ DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const Sdp
   DpSlamOptions b = bottom;
   const std::uint32_t n = b.particle_count;
   // Anchored segments keep at most 2N-1 nodes each (prune bound); the restart needs N+1;
-  // one global-map root; headroom.
+  // headroom.
   b.extra_ancestry_nodes = sdp.max_levels * 2U * n + n + 8U;
   // Anchored leaves keep their uncommitted poses: at most N × segment length per segment.
   b.extra_path_entries = (sdp.max_levels + 1U) * n * sdp.max_segment_scans;
@@ -152,7 +152,11 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   const std::size_t L = s.max_levels;
   const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
   const std::size_t cs = coarse_side_cells(b, s);
-  std::size_t total = fb + gb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
+  const std::size_t pb = PermanentMap::required_bytes(DpMap::cells_along(b.map_width_m, b.map_resolution_m),
+                                                      DpMap::cells_along(b.map_height_m, b.map_resolution_m),
+                                                      s.permanent_map_tiles);
+  if (pb == 0U) return 0U;
+  std::size_t total = fb + gb + pb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
   total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
   total += Arena::bytes_for<Submap>(L * n) + Arena::bytes_for<Point2>(L * n * s.skeleton_points) + Arena::bytes_for<Level>(L);
   total += Arena::bytes_for<Permanent>(s.max_permanent_submaps) + Arena::bytes_for<Point2>(s.max_permanent_submaps * std::size_t{s.skeleton_points});
@@ -179,6 +183,12 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   if (!s.validate(why_, sizeof why_)) return false;
   const DpSlamOptions b = bottom_options_for(bottom_in, s);
   if (!b.validate(why_, sizeof why_)) return false;
+  const std::int32_t map_w = DpMap::cells_along(b.map_width_m, b.map_resolution_m);
+  const std::int32_t map_h = DpMap::cells_along(b.map_height_m, b.map_resolution_m);
+  if (PermanentMap::required_bytes(map_w, map_h, s.permanent_map_tiles) == 0U) {
+    std::snprintf(why_, sizeof why_, "permanent map: the %d x %d cell map area is out of range", map_w, map_h);
+    return false;
+  }
   const std::size_t need = required_arena_bytes(bottom_in, s);
   if (need == 0U || arena.available_bytes() < need) {
     std::snprintf(why_, sizeof why_, "arena too small: %zu bytes available, %zu needed", arena.available_bytes(), need);
@@ -211,6 +221,10 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     return false;
   }
   filter_->set_pose_sink(&ring_sink_);
+  if (!permanent_map_.init(arena, filter_->map().width_cells(), filter_->map().height_cells(), s.permanent_map_tiles)) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the permanent map");
+    return false;
+  }
   if (!graph_.init(graph_options(s, n_bottom_), arena)) {
     std::snprintf(why_, sizeof why_, "PGS init failed");
     return false;
@@ -551,11 +565,11 @@ void SdpSlam::make_oldest_permanent() {
   for (std::uint32_t k = 0; k < count; ++k) {
     if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = submap(level, k).node;
   }
-  if (global_node_ == kNoNode) global_node_ = filter_->create_anchored_root();
   transfer_ = Transfer{};
   transfer_.active = true;
   transfer_.node = sm.node;
   transfer_.frame = r.frame_in_global;
+  transfer_.tag = level + 1U;
   transfer_.rect = sm.map_rect;
   transfer_.next_row = 0U;
   // Committed poses of the level leave the ring (they are the oldest).
@@ -567,8 +581,9 @@ void SdpSlam::make_oldest_permanent() {
   levels_[slot(level)].count = 0U;
 }
 
-// One cell of the permanent submap into the global map node, at its place in the global
-// frame; counted, and counted as dropped when outside the map or refused (pool full).
+// One cell of the permanent submap into the permanent map, at its place in the global
+// frame, tagged with its level; counted, and counted as dropped when outside the map or
+// refused (every tile taken).
 void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v) {
   const DpMap& map = filter_->map();
   double cx = 0.0;
@@ -580,7 +595,7 @@ void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservat
   std::int32_t gix = 0;
   std::int32_t giy = 0;
   ++stats_.map_transfer_cells;
-  if (!map.world_to_cell(gx, gy, &gix, &giy) || !filter_->add_to_anchored(global_node_, gix, giy, v.hits, v.misses)) {
+  if (!map.world_to_cell(gx, gy, &gix, &giy) || !permanent_map_.add(gix, giy, v.hits, v.misses, transfer_.tag)) {
     ++stats_.map_transfer_dropped;
   }
 }
@@ -590,7 +605,7 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   const DpMap& map = filter_->map();
   const CellRect& r = transfer_.rect;
   std::uint32_t used = 0U;
-  if (r.width == 0U || global_node_ == kNoNode) {
+  if (r.width == 0U || !permanent_map_.initialised()) {
     transfer_.next_row = r.height;
   }
   if (transfer_.mode == TransferMode::kUndecided) {

@@ -51,6 +51,7 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   DOUBLES_EQUAL(d.loop_search_confirm_xy_m, o.loop_search_confirm_xy_m, 0.0);
   DOUBLES_EQUAL(d.loop_search_confirm_rad, o.loop_search_confirm_rad, 0.0);
   DOUBLES_EQUAL(d.loop_search_drift_m, o.loop_search_drift_m, 0.0);
+  LONGS_EQUAL(d.permanent_map_tiles, o.permanent_map_tiles);
   LONGS_EQUAL(d.loop_search_candidates, o.loop_search_candidates);
   DOUBLES_EQUAL(d.loop_search_robust_chi, o.loop_search_robust_chi, 0.0);
   LONGS_EQUAL(d.loop_search_reads_per_scan, o.loop_search_reads_per_scan);
@@ -174,6 +175,10 @@ TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
   CHECK_TRUE_TEXT(why.find("loop_search_drift_m") != std::string::npos, why.c_str());
   CHECK(slam::apply_sdp_key(&o, "loop_search_drift_m", "0", &why) == slam::SdpKeyResult::kApplied);
   DOUBLES_EQUAL(0.0, o.loop_search_drift_m, 0.0);
+  CHECK(slam::apply_sdp_key(&o, "permanent_map_tiles", "0", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK_TRUE_TEXT(why.find("permanent_map_tiles") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "permanent_map_tiles", "1234", &why) == slam::SdpKeyResult::kApplied);
+  LONGS_EQUAL(1234, o.permanent_map_tiles);
   CHECK(slam::apply_sdp_key(&o, "loop_search_reads_per_scan", "100", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "loop_search_robust_chi", "12.5", &why) == slam::SdpKeyResult::kApplied);
   DOUBLES_EQUAL(12.5, o.loop_search_robust_chi, 0.0);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <set>
+#include <utility>
 
 #include "sdp_harness.h"
 
@@ -140,6 +142,55 @@ double mean_error_to_truth(const Trace& t, const test::ScanSet& set) {
   }
   return sum / static_cast<double>(t.stamps.size());
 }
+
+// Share of the laser returns of the permanent path's scans, cast from the poses the run
+// ended with, that land within one cell of an occupied cell of the global map's
+// permanent part: drawn as the outputs draw it (each cell moved with its level's frame,
+// `corrected`) or where the cells were copied.
+double permanent_map_agreement(const SdpSlam& slam, const test::ScanSet& set, const test::CollectPoses& sink,
+                               bool corrected) {
+  const DpMap& map = slam.bottom().map();
+  const double res = map.resolution_m();
+  std::set<std::pair<long, long>> occupied;
+  auto add = [&](double x, double y, const CellObservation& v) {
+    if (v.hits > 0U && 2U * v.hits >= static_cast<unsigned>(v.hits) + v.misses) {
+      occupied.insert({std::lround(std::floor(x / res)), std::lround(std::floor(y / res))});
+    }
+  };
+  if (corrected) {
+    slam.for_each_permanent_cell(add);
+  } else {
+    slam.permanent_map().for_each_cell([&](std::int32_t ix, std::int32_t iy, const PermanentMap::Cell& c) {
+      double x = 0.0;
+      double y = 0.0;
+      map.cell_center(ix, iy, &x, &y);
+      add(x, y, c.value);
+    });
+  }
+  const std::vector<Pose2> poses = sink.poses();
+  std::size_t hit = 0U;
+  std::size_t all = 0U;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const RangeScan& scan = *set.scans[static_cast<std::size_t>(sink.stamps[k] / 100000)];
+    const Pose2 laser = poses[k].compose(scan.geometry.laser_in_base);
+    for (std::uint32_t i = 0; i < scan.beam_count; ++i) {
+      if (scan.classify(i) != RangeScan::Beam::kReturn) continue;
+      const double a = scan.beam_angle_rad(i);
+      double x = 0.0;
+      double y = 0.0;
+      laser.transform_point(scan.ranges_m[i] * std::cos(a), scan.ranges_m[i] * std::sin(a), x, y);
+      const long cx = std::lround(std::floor(x / res));
+      const long cy = std::lround(std::floor(y / res));
+      bool near = false;
+      for (long dy = -1; dy <= 1 && !near; ++dy) {
+        for (long dx = -1; dx <= 1 && !near; ++dx) near = occupied.count({cx + dx, cy + dy}) > 0U;
+      }
+      hit += near ? 1U : 0U;
+      ++all;
+    }
+  }
+  return all > 0U ? static_cast<double>(hit) / static_cast<double>(all) : 0.0;
+}
 }  // namespace
 
 // Beyond the paper: loop constraints found, the best combination's frames adjusted (the
@@ -176,13 +227,21 @@ TEST(SdpSlam, loop_closure_adjusts_the_frames_and_the_permanent_path_follows) {
               with_m, without_m, static_cast<unsigned long long>(st.loop_records_added),
               static_cast<unsigned long long>(st.frame_adjustments));
   CHECK(with_m < without_m);  // measured: 0.509 m against 1.060 m (0.448 m with isotropic loops)
-  // The global map's permanent part keeps the frames of the copy: how far the
-  // adjustments moved them since is measured, and is 0 without loop closure.
-  std::printf("  permanent map offset: %.3f m after the last adjustment, %.3f m at most\n", st.permanent_map_offset_m,
-              st.permanent_map_offset_max_m);
+  // The adjustments moved permanent frames after their maps were copied (0 without loop
+  // closure), and the map follows them: the permanent path's own laser returns fall on
+  // the drawn walls more often than on the walls where they were copied.
+  std::printf("  permanent map correction: %.3f m after the last adjustment, %.3f m at most\n",
+              st.permanent_map_offset_m, st.permanent_map_offset_max_m);
   CHECK(st.permanent_map_offset_max_m > 0.0);
   CHECK(st.permanent_map_offset_m <= st.permanent_map_offset_max_m);
   DOUBLES_EQUAL(0.0, b.slam->stats().permanent_map_offset_max_m, 0.0);
+  const double drawn = permanent_map_agreement(*a.slam, set, sa, true);
+  const double as_copied = permanent_map_agreement(*a.slam, set, sa, false);
+  std::printf("  laser returns on the permanent map's walls: %.3f drawn with the corrections, %.3f as copied\n", drawn,
+              as_copied);
+  CHECK(drawn > as_copied);
+  // Without corrections the two drawings are the same map.
+  DOUBLES_EQUAL(permanent_map_agreement(*b.slam, set, sb, true), permanent_map_agreement(*b.slam, set, sb, false), 0.0);
   // Deterministic with loop closure too.
   test::SdpRig c;
   CHECK_TRUE(c.init(test::sim_options(5), s, 21));
@@ -498,7 +557,7 @@ TEST(SdpSlam, dispersion_segmentation_runs_end_to_end) {
   CHECK(t.poses.size() > 50U);
 }
 
-TEST(SdpSlam, the_best_map_is_made_of_the_global_node_live_submaps_and_the_current_one) {
+TEST(SdpSlam, the_best_map_is_made_of_the_permanent_map_live_submaps_and_the_current_one) {
   const test::ScanSet set(3);
   test::SdpRig rig;
   CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 11));
@@ -512,7 +571,19 @@ TEST(SdpSlam, the_best_map_is_made_of_the_global_node_live_submaps_and_the_curre
     std::vector<std::uint8_t> k(v.size());
     known += rig.slam->bottom().map().fill_rect(node, r, v.data(), k.data());
   });
-  // global node + 4 live levels + the current segment
-  LONGS_EQUAL(6, views);
+  // 4 live levels + the current segment (no copy pending after finish())
+  LONGS_EQUAL(5, views);
   CHECK(known > 1000U);
+  // The permanent part: every cell of the permanent map, drawn once, tagged with a level
+  // that was made permanent.
+  const PermanentMap& pm = rig.slam->permanent_map();
+  CHECK(rig.slam->stats().levels_made_permanent > 0U);
+  CHECK(pm.known_cells() > 1000U);
+  std::uint64_t drawn = 0U;
+  rig.slam->for_each_permanent_cell([&](double, double, const CellObservation&) { ++drawn; });
+  LONGS_EQUAL(pm.known_cells(), drawn);
+  pm.for_each_cell([&](std::int32_t, std::int32_t, const PermanentMap::Cell& c) {
+    CHECK(c.tag >= 1U && c.tag <= rig.slam->stats().levels_made_permanent);
+  });
+  LONGS_EQUAL(0, pm.refused_no_tile());
 }

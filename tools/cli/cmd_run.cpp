@@ -69,13 +69,6 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
                    static_cast<unsigned long long>(s.scans), static_cast<unsigned long long>(s.processed),
                    static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
                    s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
-      if (s.permanent_map_offset_max_m > 2.0 * ro.config.filter.map_resolution_m) {
-        std::fprintf(stderr,
-                     "sdpslam run: note: loop closure moved permanent submaps by up to %.2f m after their maps were "
-                     "copied; map.pgm keeps the old places there (trajectory.txt follows; stats.json "
-                     "global_map_transfers.permanent_offset_max_m)\n",
-                     s.permanent_map_offset_max_m);
-      }
       return kExitOk;
     case slam::SdpRunStatus::kBadInput: return report("", kExitBadInput, error);
     case slam::SdpRunStatus::kIoError: return report("", kExitIo, error);

@@ -192,6 +192,7 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   }
   else if (key == "map_tile_capacity") ok = integer(&t.map_tile_capacity);
   else if (key == "map_observation_capacity") ok = integer(&t.map_observation_capacity);
+  else if (key == "permanent_map_tiles") ok = integer(&t.permanent_map_tiles);
   else if (key == "map_owner_cell_index") {
     if (v == "true") t.map_owner_cell_index = true;
     else if (v == "false") t.map_owner_cell_index = false;
@@ -402,7 +403,6 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();
     summary->icp_error_samples = st.error_samples;
-    summary->permanent_map_offset_max_m = st.permanent_map_offset_max_m;
   }
   return SdpRunStatus::kOk;
 }

@@ -113,6 +113,13 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   const double oy = map.options().origin_y_m;
   // Bounds in the global frame.
   double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
+  const double half = 0.5 * res;
+  slam.for_each_permanent_cell([&](double x, double y, const CellObservation&) {
+    gx0 = std::min(gx0, x - half);
+    gy0 = std::min(gy0, y - half);
+    gx1 = std::max(gx1, x + half);
+    gy1 = std::max(gy1, y + half);
+  });
   slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
     if (r.width == 0U || r.height == 0U) return;
     const double xs[2] = {ox + r.ix0 * res, ox + (r.ix0 + static_cast<double>(r.width)) * res};
@@ -137,6 +144,15 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   std::vector<CellObservation> sum(static_cast<std::size_t>(w) * h);
   std::vector<std::uint8_t> any(sum.size(), 0U);
   std::uint32_t known_cells = 0U;
+  // The permanent part, each cell moved with its level's frame (SdpSlam::for_each_permanent_cell).
+  slam.for_each_permanent_cell([&](double x, double y, const CellObservation& v) {
+    const double fx = std::floor((x - ax0) / res);
+    const double fy = std::floor((y - ay0) / res);
+    if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) return;
+    const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
+    sum[g] = accumulate(sum[g], v.hits, v.misses);
+    any[g] = 1U;
+  });
   slam.for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
     if (r.width == 0U || r.height == 0U) return;
     std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
@@ -234,6 +250,10 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         ", \"refused\": " + u(st.pgs_refused) + "},\n";
   js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +
         u(slam.permanent_submap_count()) + ", \"forgotten\": " + u(st.permanent_forgotten) + "},\n";
+  const PermanentMap& pmap = slam.permanent_map();
+  js += "    \"permanent_map_tiles\": {\"capacity\": " + u(pmap.tile_capacity()) + ", \"used\": " +
+        u(pmap.tiles_used()) + ", \"known_cells\": " + u(pmap.known_cells()) + ", \"exhausted\": " +
+        u(pmap.refused_no_tile()) + "},\n";
   js += "    \"pose_ring\": {\"capacity\": " + u(slam.pose_ring_capacity()) + ", \"peak\": " + u(st.pose_ring_peak) +
         ", \"dropped\": " + u(st.pose_ring_dropped) + "},\n";
   js += "    \"map_updates_dropped\": " + u(bs.map_updates_dropped) + ",\n";

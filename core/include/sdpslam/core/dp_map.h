@@ -116,6 +116,9 @@ class DpMap final : public TreeListener {
   // > 0, cells per axis < 2^31 and the tile table < 2^32 entries, 1 ≤ tile_capacity ≤
   // capacity::kDpMaxTiles, 1 ≤ observation_capacity ≤ 2^30 (the index stays < 2^31 slots).
   static bool options_valid(const Options& options);
+  // Whole cells covering `extent_m` at `resolution_m`, as init() rounds an axis; 0 iff out
+  // of range.
+  static std::int32_t cells_along(double extent_m, double resolution_m);
 
   // Validates `options`, keeps a reference to `tree` (initialised first: its capacity
   // sizes the per-node table) and carves all storage from `arena`. Returns false iff the

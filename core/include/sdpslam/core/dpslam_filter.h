@@ -126,12 +126,6 @@ class DpSlamFilter {
   // once nothing descends from it. False (nothing changes) iff `node` is dead or is the
   // node of a current particle. O(prune).
   bool release_anchored(NodeId node);
-  // A new root node that is not a particle (e.g. a permanent global map assembled from
-  // finished submaps); it stays active until released. kNoNode iff the pool is full.
-  NodeId create_anchored_root();
-  // Adds evidence to cell (ix, iy) of a node that is not a current particle (same
-  // failure rules as DpMap::add, plus false iff `node` is a current particle).
-  bool add_to_anchored(NodeId node, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
   // DpMap::pop_observation() on a node that is not a current particle (false, changing
   // nothing, for a particle's node).
   bool pop_anchored_observation(NodeId node, std::int32_t* ix, std::int32_t* iy, CellObservation* value);

@@ -38,8 +38,8 @@
 // Bounded memory: when all max_levels PGS levels are live, the oldest becomes PERMANENT
 // with the best top particle's choice: that submap's poses go to the permanent path
 // sink (SdpPathSink: the poses in its frame, and that frame in the global frame), its
-// map is copied into one global "permanent map" node (a tree root that is not a
-// particle) and its skeleton into a ring of permanent
+// map is copied into the global map's permanent part (permanent_map.h: one grid, each
+// cell tagged with the level that put it there) and its skeleton into a ring of permanent
 // submaps (still matched for loop closures); the level's other submaps are released
 // (set_active(false) + prune frees their DP-map observations; counted), one submap per
 // call of process() so that no single scan pays for all of them.
@@ -57,8 +57,9 @@
 // adjusted by a pose graph (frame_graph.h) whose chain constraints are the transforms T
 // of Fig. 3 (l) and whose loops are those constraints. Permanent frames and the PGS
 // anchor move with it, so later samples are placed from the corrected frames; the
-// permanent path sink is told every new frame, so the trajectory follows. The global
-// map's permanent part keeps the frames its submaps had when they were copied into it.
+// permanent path sink is told every new frame, so the trajectory follows, and so does
+// the map: each permanent cell is drawn moved by its level's correction since the copy
+// (for_each_permanent_cell).
 // Wide loop search (SdpOptions::loop_search_window_m > 0): ICP only sees loops the chain
 // already closed to within decimetres, so once per level the chosen submap is also
 // searched against the older submaps it may revisit, over metres and tenths of a
@@ -88,6 +89,7 @@
 #include "sdpslam/core/frame_graph.h"
 #include "sdpslam/core/free_space_skeleton.h"
 #include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/permanent_map.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/segment_graph.h"
 #include "sdpslam/core/segmentation.h"
@@ -115,10 +117,11 @@ struct SdpStats {
   std::uint64_t map_transfer_dropped = 0U;  // global-map cell updates refused (pool full)
   std::uint64_t map_transfers_popped = 0U;  // permanent submaps copied by popping (the rule)
   std::uint64_t map_transfers_by_rows = 0U; // ... by reading their rectangle (fallback)
-  // The global map's permanent part keeps the frames its submaps had when copied; loop
-  // closure may move those frames later. How far (m, at the submap's box corners) the
-  // copied map of a permanent submap lies from its adjusted frame: the largest over the
-  // ring after the last adjustment, and the largest ever seen.
+  // The global map's permanent part is stored where its submaps' frames were when copied;
+  // loop closure may move those frames later, and the map is drawn moved with them
+  // (for_each_permanent_cell). How far (m, at the submap's box corners) that correction
+  // moves a permanent submap's cells: the largest over the ring after the last
+  // adjustment, and the largest ever seen.
   double permanent_map_offset_m = 0.0;
   double permanent_map_offset_max_m = 0.0;
   std::uint64_t rounds = 0U;
@@ -213,10 +216,18 @@ class SdpSlam {
   template <class F>
   void for_each_best_pose(F&& f) const;
   // f(node, frame_in_global, rect) for every DP-map view that makes up the best global
-  // map: the permanent map node (identity frame), each live level's chosen submap and
-  // the current segment's best particle; rect bounds the cells worth reading.
+  // map besides its permanent part: the permanent submap still being copied (what is
+  // not copied yet), each live level's chosen submap and the current segment's best
+  // particle; rect bounds the cells worth reading.
   template <class F>
   void for_each_best_submap(F&& f) const;
+  // f(x_m, y_m, value) for every cell of the global map's permanent part: the centre of
+  // the cell in the global frame, moved by the correction its level's frame got since
+  // the cell was copied (frame_now ⊕ frame_at_copy⁻¹). A cell of a level that left the
+  // ring of permanent submaps (max_permanent_submaps) stays where it was copied.
+  template <class F>
+  void for_each_permanent_cell(F&& f) const;
+  const PermanentMap& permanent_map() const { return permanent_map_; }
   // Frame of the current segment in the global frame for the best top particle.
   Pose2 current_frame() const { return current_frame_; }
   std::uint32_t best_top_particle() const { return best_top_; }
@@ -316,7 +327,8 @@ class SdpSlam {
     bool active = false;
     TransferMode mode = TransferMode::kUndecided;
     NodeId node = kNoNode;
-    Pose2 frame;
+    Pose2 frame;            // the level's frame in the global frame at the copy
+    std::uint32_t tag = 0U;  // PermanentMap tag of its cells: level + 1
     CellRect rect{};
     std::uint32_t next_row = 0U;
   };
@@ -481,7 +493,7 @@ class SdpSlam {
   std::uint32_t release_count_ = 0U;
   Transfer transfer_{};
   SkeletonJob skeleton_job_{};
-  NodeId global_node_ = kNoNode;
+  PermanentMap permanent_map_;
 
   // Current segment.
   bool started_ = false;
@@ -543,15 +555,14 @@ void SdpSlam::for_each_best_pose(F&& f) const {
 template <class F>
 void SdpSlam::for_each_best_submap(F&& f) const {
   if (!initialised_ || !started_) return;
-  CellRect all{};
-  if (global_node_ != kNoNode && filter_->map().touched_bounds(&all)) f(global_node_, Pose2{}, all);
-  if (transfer_.active) {
-    // What the global node does not hold yet: a popped node keeps only the cells not
-    // copied; in strips, the rows not copied.
+  if (transfer_.active && perm_count_ > 0U) {
+    // What the permanent map does not hold yet: a popped node keeps only the cells not
+    // copied; in strips, the rows not copied. At its level's frame now (the newest
+    // permanent submap).
     CellRect rest = transfer_.rect;
     rest.iy0 += static_cast<std::int32_t>(transfer_.next_row);
     rest.height -= transfer_.next_row;
-    f(transfer_.node, transfer_.frame, rest);
+    f(transfer_.node, perm_[(perm_head_ + perm_count_ - 1U) % options_.max_permanent_submaps].frame_in_global, rest);
   }
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
@@ -561,6 +572,34 @@ void SdpSlam::for_each_best_submap(F&& f) const {
   }
   const double pad = bottom_options_.beam.max_update_range_m;
   f(filter_->best_node(), current_frame_, rect_around(seg_box_[0], seg_box_[1], seg_box_[2], seg_box_[3], pad));
+}
+
+template <class F>
+void SdpSlam::for_each_permanent_cell(F&& f) const {
+  if (!initialised_) return;
+  // Levels in the ring are consecutive (the oldest live level is made permanent each
+  // time), so a tag finds its entry by offset from the oldest one still held.
+  const std::uint32_t first_level = perm_count_ > 0U ? perm_[perm_head_].level : 0U;
+  std::uint32_t last_tag = 0U;
+  Pose2 correction;
+  permanent_map_.for_each_cell([&](std::int32_t ix, std::int32_t iy, const PermanentMap::Cell& c) {
+    if (c.tag != last_tag) {
+      last_tag = c.tag;
+      correction = Pose2{};
+      const std::uint32_t level = c.tag - 1U;
+      if (level >= first_level && level - first_level < perm_count_) {
+        const Permanent& pm = perm_[(perm_head_ + (level - first_level)) % options_.max_permanent_submaps];
+        correction = pm.frame_in_global.compose(pm.frame_in_map.inverse());
+      }
+    }
+    double x = 0.0;
+    double y = 0.0;
+    filter_->map().cell_center(ix, iy, &x, &y);
+    double gx = 0.0;
+    double gy = 0.0;
+    correction.transform_point(x, y, gx, gy);
+    f(gx, gy, c.value);
+  });
 }
 
 }  // namespace sdpslam

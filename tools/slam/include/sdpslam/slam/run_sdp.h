@@ -8,8 +8,9 @@
 //                     combination of submaps: permanent segments, the live levels' chosen
 //                     submaps and the current segment's best particle; scans that were
 //                     not processed take the last estimate composed with the odometry;
-//  - map.pgm/.yaml,   the global map (Fig. 3 (j)-(l)): the permanent map node plus each
-//    map.png          chosen submap's DP-map view transformed into the global frame,
+//  - map.pgm/.yaml,   the global map (Fig. 3 (j)-(l)): the permanent map (each cell moved
+//    map.png          with its level's corrected frame) plus each
+//                     chosen submap's DP-map view transformed into the global frame,
 //                     hits and misses summed per cell; the PNG has the trajectory drawn;
 //  - icp_error.csv    "stamp_s,mean_m,std_m,samples": mean and std of the ICP error of
 //                     the top-level samples of every evaluation round that matched
@@ -46,9 +47,6 @@ struct SdpRunSummary {
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
   std::uint64_t icp_error_samples = 0U;
-  // SdpStats::permanent_map_offset_max_m: how far map.pgm's permanent part may lie from
-  // the adjusted trajectory (loop corrections after the copy).
-  double permanent_map_offset_max_m = 0.0;
 };
 
 enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };

@@ -86,7 +86,8 @@ class SdpPermanentPath final : public SdpPathSink {
 // particle (SdpSlam::for_each_best_pose).
 std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermanentPath& permanent);
 
-// The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map node plus
+// The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map (each cell
+// moved with its level's frame as loop closure corrected it) plus
 // each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
 // misses summed per cell; aligned to the DP map's grid. Returns the known cells; `image`
 // stays empty (width 0) when nothing was ever written. Allocates (the image, one view at
