@@ -10,6 +10,7 @@
 #include <string>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/map_image.h"
 #include "shared_data.h"
 
 namespace {
@@ -45,7 +46,7 @@ TEST_GROUP(CliEvaluate) {
   std::string dir;
   void setup() override { dir = sdpslam::test::make_temp_dir("cli-eval"); }
   void teardown() override {
-    for (const char* f : {"/log.clf", "/r.relations", "/t.txt", "/gt.txt", "/bad.txt", "/out.json"}) {
+    for (const char* f : {"/log.clf", "/r.relations", "/t.txt", "/gt.txt", "/bad.txt", "/out.json", "/m.pgm", "/m.yaml"}) {
       ::unlink((dir + f).c_str());
     }
     ::rmdir(dir.c_str());
@@ -140,4 +141,43 @@ TEST(CliEvaluate, unwritable_json_is_an_output_error) {
   const Run r = run_evaluate("--trajectory " + gt + " --ground-truth " + gt + " --json " + dir + "/no/dir/out.json");
   LONGS_EQUAL(4, r.status);
   STRCMP_CONTAINS("no/dir/out.json", r.out.c_str());
+}
+
+namespace {
+// A 20 m square map around the origin, every cell `p`.
+std::string uniform_map(const std::string& dir, float p) {
+  sdpslam::io::OccupancyImage m;
+  m.width = 400U;
+  m.height = 400U;
+  m.resolution_m = 0.05;
+  m.origin_x_m = -10.0;
+  m.origin_y_m = -10.0;
+  m.occupancy.assign(160000U, p);
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::write_map_pgm_yaml(dir + "/m", m, sdpslam::io::MapWriteOptions{}, &error), error.c_str());
+  return dir + "/m.yaml";
+}
+}  // namespace
+
+TEST(CliEvaluate, map_agreement_counts_the_returns_that_end_on_walls) {
+  const std::string t = put("t.txt", "10.000000 0 0 0\n11.000000 1 0 0\n12.000000 2 0 0\n");
+  const std::string json = dir + "/out.json";
+  Run r = run_evaluate("--log " + log() + " --trajectory " + t + " --map " + uniform_map(dir, 1.0F) + " --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("3 of 3 cast", r.out.c_str());
+  STRCMP_CONTAINS("9 of 9 returns = 1.0000", r.out.c_str());
+  STRCMP_CONTAINS("\"map_agreement\": {", slurp(json).c_str());
+  r = run_evaluate("--log " + log() + " --trajectory " + t + " --map " + uniform_map(dir, 0.0F));
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("0 of 9 returns = 0.0000", r.out.c_str());
+}
+
+TEST(CliEvaluate, map_agreement_needs_a_trajectory_and_a_readable_map) {
+  const std::string t = put("t.txt", "10.000000 0 0 0\n");
+  Run r = run_evaluate("--log " + log() + " --map " + uniform_map(dir, 1.0F));
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--map needs --log and --trajectory", r.out.c_str());
+  r = run_evaluate("--log " + log() + " --trajectory " + t + " --map " + dir + "/none.yaml");
+  LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
+  STRCMP_CONTAINS("none.yaml: cannot open", r.out.c_str());
 }

@@ -8,9 +8,14 @@
 //       log's own odometry poses (the "raw odometry" baseline).
 //   sdpslam evaluate --trajectory TRAJ --ground-truth GT
 //       absolute trajectory error after the best SE(2) alignment.
+//   sdpslam evaluate --log LOG --trajectory TRAJ --map MAP.yaml
+//       agreement of the map with the trajectory: the share of the log's laser returns,
+//       cast from the trajectory's poses, that end within one cell of an occupied cell
+//       (tools/eval/include/sdpslam/eval/map_agreement.h). No ground truth needed.
 //
-// Both can be asked for at once. --json FILE writes the figures as JSON (atomically).
+// Any of them can be asked for at once. --json FILE writes the figures as JSON (atomically).
 // Exit codes (cli_common.h): bad or inconsistent input → kExitBadInput with file:line.
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <functional>
@@ -21,8 +26,10 @@
 #include "cli_common.h"
 #include "sdpslam/eval/ate.h"
 #include "sdpslam/eval/log_scans.h"
+#include "sdpslam/eval/map_agreement.h"
 #include "sdpslam/eval/relations.h"
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 
 namespace sdpslam::cli {
@@ -35,6 +42,7 @@ struct EvaluateArgs {
   std::string relations_path;
   std::string trajectory_path;
   std::string ground_truth_path;
+  std::string map_path;
   std::string json_path;
   bool odometry = false;
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
@@ -228,11 +236,52 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
   return kExitOk;
 }
 
+int run_map_agreement(const EvaluateArgs& a, std::string* json) {
+  std::vector<io::StampedPose> estimate;
+  if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
+  // Logs are not always in time order (intel.clf), and trajectories follow the log.
+  std::stable_sort(estimate.begin(), estimate.end(),
+                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
+  io::OccupancyImage map;
+  io::MapWriteOptions thresholds;
+  std::string error;
+  if (!io::read_map_pgm_yaml(a.map_path, &map, &thresholds, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  eval::MapAgreementResult r;
+  if (!eval::evaluate_map_agreement(a.log_path, estimate, map, thresholds.occupied_thresh, a.tolerance_us, &r, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  std::printf("Map agreement (laser returns cast from the trajectory, ending within one cell of an occupied cell)\n");
+  std::printf("  map         %s: %u x %u cells of %.3f m\n", a.map_path.c_str(), map.width, map.height, map.resolution_m);
+  std::printf("  scans       %zu of %zu cast from %s\n", r.scans_cast, r.scan_count, a.trajectory_path.c_str());
+  std::printf("  on walls    %zu of %zu returns = %.4f\n", r.on_wall_count, r.return_count, r.share());
+  *json += "\"map_agreement\": {\"map\": " + json_string(a.map_path) + ", \"trajectory\": " + json_string(a.trajectory_path) +
+           ", \"scan_count\": " + std::to_string(r.scan_count) + ", \"scans_cast\": " + std::to_string(r.scans_cast) +
+           ", \"return_count\": " + std::to_string(r.return_count) +
+           ", \"on_wall_count\": " + std::to_string(r.on_wall_count) + ", \"share\": " + json_number(r.share()) + "}";
+  if (r.scans_cast == 0U) {
+    std::fprintf(stderr, "sdpslam evaluate: no scan of %s has a pose in %s\n", a.log_path.c_str(),
+                 a.trajectory_path.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
 int run_evaluate(const EvaluateArgs& a) {
   const bool want_relations = !a.relations_path.empty();
   const bool want_ate = !a.ground_truth_path.empty();
-  if (!want_relations && !want_ate) {
-    std::fprintf(stderr, "sdpslam evaluate: give --relations (with --log) or --ground-truth (with --trajectory)\n");
+  const bool want_map = !a.map_path.empty();
+  if (!want_relations && !want_ate && !want_map) {
+    std::fprintf(stderr,
+                 "sdpslam evaluate: give --relations (with --log), --ground-truth (with --trajectory) or --map (with "
+                 "--log and --trajectory)\n");
+    return kExitUsage;
+  }
+  if (want_map && (a.log_path.empty() || a.trajectory_path.empty())) {
+    std::fprintf(stderr, "sdpslam evaluate: --map needs --log and --trajectory\n");
     return kExitUsage;
   }
   if (want_relations && (a.log_path.empty() || (a.trajectory_path.empty() == !a.odometry))) {
@@ -258,6 +307,13 @@ int run_evaluate(const EvaluateArgs& a) {
     }
     if (const int rc = run_ate(a, &json); rc != kExitOk) return rc;
   }
+  if (want_map) {
+    if (want_relations || want_ate) {
+      json += ", ";
+      std::printf("\n");
+    }
+    if (const int rc = run_map_agreement(a, &json); rc != kExitOk) return rc;
+  }
   json += "}\n";
   if (!a.json_path.empty()) {
     std::string error;
@@ -277,6 +333,7 @@ std::function<int()> setup_evaluate(CLI::App& app) {
   app.add_flag("--odometry", args->odometry, "evaluate the log's own odometry poses (raw-odometry baseline)")
       ->excludes(traj);
   app.add_option("--ground-truth", args->ground_truth_path, "ground-truth trajectory for the absolute error");
+  app.add_option("--map", args->map_path, "map (map_server YAML + PGM) whose agreement with --trajectory to measure");
   app.add_option("--json", args->json_path, "also write the figures to this JSON file");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
                  "stamps closer than this name the same scan when not equal (default 1000)");
@@ -285,7 +342,7 @@ std::function<int()> setup_evaluate(CLI::App& app) {
 
 }  // namespace
 
-SDPSLAM_REGISTER_COMMAND(evaluate, "evaluate", "accuracy of a trajectory: relations metric and ATE", 40,
+SDPSLAM_REGISTER_COMMAND(evaluate, "evaluate", "accuracy of a trajectory (relations metric, ATE) and its map's agreement with it", 40,
                          setup_evaluate);
 
 }  // namespace sdpslam::cli

@@ -16,7 +16,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
@@ -312,6 +315,152 @@ bool write_map_png(const std::string& path, const OccupancyImage& map, const std
     return false;
   }
   return write_file_atomic(path, bytes, error);
+}
+
+}  // namespace sdpslam::io
+
+namespace sdpslam::io {
+
+namespace {
+
+bool map_read_error(std::string* error, const std::string& where, const std::string& why) {
+  if (error != nullptr) *error = where + ": " + why;
+  return false;
+}
+
+std::string trim(const std::string& s) {
+  const std::size_t b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  const std::size_t e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1U);
+}
+
+bool parse_real(const std::string& text, double* out) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || trim(end).size() != 0U || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
+// Next whitespace-separated token of a PGM header, skipping '#' comments.
+bool pgm_token(const std::string& data, std::size_t* pos, std::string* token) {
+  while (*pos < data.size()) {
+    const char c = data[*pos];
+    if (c == '#') {
+      while (*pos < data.size() && data[*pos] != '\n') ++*pos;
+    } else if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+      ++*pos;
+    } else {
+      break;
+    }
+  }
+  const std::size_t start = *pos;
+  while (*pos < data.size() && data[*pos] != ' ' && data[*pos] != '\t' && data[*pos] != '\r' && data[*pos] != '\n') {
+    ++*pos;
+  }
+  *token = data.substr(start, *pos - start);
+  return !token->empty();
+}
+
+}  // namespace
+
+bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
+                       std::string* error) {
+  std::ifstream yaml(yaml_path);
+  if (!yaml) return map_read_error(error, yaml_path, "cannot open");
+  std::string image;
+  double resolution = 0.0;
+  double origin_x = 0.0;
+  double origin_y = 0.0;
+  MapWriteOptions t;
+  bool have_resolution = false;
+  bool have_origin = false;
+  std::string line;
+  for (int n = 1; std::getline(yaml, line); ++n) {
+    const std::string where = yaml_path + ":" + std::to_string(n);
+    const std::size_t colon = line.find(':');
+    if (trim(line).empty() || trim(line)[0] == '#') continue;
+    if (colon == std::string::npos) return map_read_error(error, where, "expected 'key: value'");
+    const std::string key = trim(line.substr(0, colon));
+    const std::string value = trim(line.substr(colon + 1U));
+    if (key == "image") {
+      image = value;
+    } else if (key == "resolution") {
+      if (!parse_real(value, &resolution) || !(resolution > 0.0)) return map_read_error(error, where, "resolution must be > 0");
+      have_resolution = true;
+    } else if (key == "origin") {
+      double z = 0.0;
+      std::string v = value;
+      if (v.size() < 2U || v.front() != '[' || v.back() != ']') return map_read_error(error, where, "origin must be [x, y, yaw]");
+      v = v.substr(1U, v.size() - 2U);
+      std::stringstream parts(v);
+      std::string a, b, c;
+      if (!std::getline(parts, a, ',') || !std::getline(parts, b, ',') || !std::getline(parts, c, ',') ||
+          !parse_real(a, &origin_x) || !parse_real(b, &origin_y) || !parse_real(c, &z)) {
+        return map_read_error(error, where, "origin must be [x, y, yaw]");
+      }
+      if (z != 0.0) return map_read_error(error, where, "a rotated origin (yaw != 0) is not supported");
+      have_origin = true;
+    } else if (key == "negate") {
+      if (value != "0" && value != "1") return map_read_error(error, where, "negate must be 0 or 1");
+      t.negate = value == "1";
+    } else if (key == "occupied_thresh") {
+      if (!parse_real(value, &t.occupied_thresh)) return map_read_error(error, where, "occupied_thresh is not a number");
+    } else if (key == "free_thresh") {
+      if (!parse_real(value, &t.free_thresh)) return map_read_error(error, where, "free_thresh is not a number");
+    }
+  }
+  if (image.empty()) return map_read_error(error, yaml_path, "no 'image' key");
+  if (!have_resolution) return map_read_error(error, yaml_path, "no 'resolution' key");
+  if (!have_origin) return map_read_error(error, yaml_path, "no 'origin' key");
+  if (!(t.free_thresh >= 0.0 && t.free_thresh < t.occupied_thresh && t.occupied_thresh <= 1.0)) {
+    return map_read_error(error, yaml_path, "thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1");
+  }
+  std::string pgm_path = image;
+  const std::size_t slash = yaml_path.find_last_of('/');
+  if (image[0] != '/' && slash != std::string::npos) pgm_path = yaml_path.substr(0, slash + 1U) + image;
+  std::ifstream in(pgm_path, std::ios::binary);
+  if (!in) return map_read_error(error, pgm_path, "cannot open (named by " + yaml_path + ")");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string data = ss.str();
+  std::size_t pos = 0U;
+  std::string magic, ws, hs, ms;
+  if (!pgm_token(data, &pos, &magic) || magic != "P5") return map_read_error(error, pgm_path, "not a binary PGM (P5)");
+  if (!pgm_token(data, &pos, &ws) || !pgm_token(data, &pos, &hs) || !pgm_token(data, &pos, &ms)) {
+    return map_read_error(error, pgm_path, "truncated header");
+  }
+  const long w = std::strtol(ws.c_str(), nullptr, 10);
+  const long h = std::strtol(hs.c_str(), nullptr, 10);
+  const long maxval = std::strtol(ms.c_str(), nullptr, 10);
+  if (w <= 0 || h <= 0 || w > 100000 || h > 100000) return map_read_error(error, pgm_path, "bad size " + ws + " x " + hs);
+  if (maxval <= 0 || maxval > 255) return map_read_error(error, pgm_path, "maxval must be 1..255");
+  ++pos;  // the single whitespace after maxval
+  const std::size_t cells = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  if (data.size() < pos + cells) {
+    return map_read_error(error, pgm_path,
+                          "image data short: " + std::to_string(data.size() - pos) + " of " + std::to_string(cells) + " bytes");
+  }
+  OccupancyImage m;
+  m.width = static_cast<std::uint32_t>(w);
+  m.height = static_cast<std::uint32_t>(h);
+  m.resolution_m = resolution;
+  m.origin_x_m = origin_x;
+  m.origin_y_m = origin_y;
+  m.occupancy.assign(cells, -1.0F);
+  for (std::uint32_t r = 0; r < m.height; ++r) {
+    const std::size_t src = pos + static_cast<std::size_t>(m.height - 1U - r) * m.width;
+    for (std::uint32_t c = 0; c < m.width; ++c) {
+      const double v = static_cast<unsigned char>(data[src + c]) / static_cast<double>(maxval);
+      const double p = t.negate ? v : 1.0 - v;
+      if (p > t.free_thresh && p < t.occupied_thresh) continue;  // unknown
+      m.occupancy[static_cast<std::size_t>(r) * m.width + c] = static_cast<float>(p);
+    }
+  }
+  *map = std::move(m);
+  if (thresholds != nullptr) *thresholds = t;
+  return true;
 }
 
 }  // namespace sdpslam::io

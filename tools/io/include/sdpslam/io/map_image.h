@@ -33,6 +33,16 @@ struct MapWriteOptions {
 bool write_map_pgm_yaml(const std::string& stem, const OccupancyImage& map, const MapWriteOptions& options,
                         std::string* error);
 
+// Reads a map written in the map_server convention: the YAML at `yaml_path` (image,
+// resolution, origin, negate, occupied_thresh, free_thresh; other keys ignored) and the
+// binary PGM (P5, maxval <= 255) it names, relative to the YAML's folder. A pixel's
+// occupancy is (255 - v) / 255 (v / 255 with negate); one strictly between free_thresh
+// and occupied_thresh is unknown (-1), as map_server reads it. `thresholds` (may be null)
+// gets the YAML's. False, with "file[:line]: why" in `error`, on a missing file or key, a
+// bad value or a short image.
+bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
+                       std::string* error);
+
 // Writes a grey PNG of the map; if `trajectory` is non-empty it is drawn in colour
 // (RGB PNG) on top, with the start and end marked.
 bool write_map_png(const std::string& path, const OccupancyImage& map, const std::vector<StampedPose>& trajectory,

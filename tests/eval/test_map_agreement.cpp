@@ -1,0 +1,140 @@
+// Map agreement (map_agreement.h) and the map_server reader it uses: returns cast from
+// the right poses end on the walls, from shifted poses they do not; the reader gives back
+// what the writer wrote and names the file and line of what it cannot read.
+#include <CppUTest/TestHarness.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "sdpslam/eval/map_agreement.h"
+#include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/map_image.h"
+#include "shared_data.h"
+
+using sdpslam::Pose2;
+using sdpslam::RangeScan;
+using sdpslam::eval::MapAgreement;
+using sdpslam::io::MapWriteOptions;
+using sdpslam::io::OccupancyImage;
+
+namespace {
+
+// 5 m × 5 m at 5 cm centred on the origin, free, with a wall along x = 1.0 .. 1.05 m.
+OccupancyImage wall_map() {
+  OccupancyImage m;
+  m.width = 100U;
+  m.height = 100U;
+  m.resolution_m = 0.05;
+  m.origin_x_m = -2.5;
+  m.origin_y_m = -2.5;
+  m.occupancy.assign(10000U, 0.0F);
+  for (std::uint32_t r = 0; r < 100U; ++r) m.occupancy[r * 100U + 70U] = 1.0F;  // column 70: x in [1.0, 1.05)
+  return m;
+}
+
+// 21 beams over ±0.5 rad, each ending on the plane x = 1.02 m seen from the origin.
+std::unique_ptr<RangeScan> scan_of_wall() {
+  auto s = std::make_unique<RangeScan>();
+  s->geometry.angle_min_rad = -0.5F;
+  s->geometry.angle_increment_rad = 0.05F;
+  s->geometry.range_min_m = 0.05F;
+  s->geometry.range_max_m = 10.0F;
+  s->beam_count = 23U;
+  for (std::uint32_t i = 0; i < 21U; ++i) s->ranges_m[i] = static_cast<float>(1.02 / std::cos(s->beam_angle_rad(i)));
+  s->ranges_m[21] = 10.0F;  // no return: not counted
+  s->ranges_m[22] = 0.0F;   // invalid: not counted
+  return s;
+}
+
+}  // namespace
+
+TEST_GROUP(MapAgreement){};
+
+TEST(MapAgreement, returns_cast_from_the_true_pose_end_on_the_wall_and_from_a_shifted_one_do_not) {
+  const OccupancyImage map = wall_map();
+  const auto scan = scan_of_wall();
+  MapAgreement right(map, 0.65);
+  right.add_scan(Pose2{0.0, 0.0, 0.0}, *scan);
+  LONGS_EQUAL(1, right.result().scans_cast);
+  LONGS_EQUAL(21, right.result().return_count);
+  LONGS_EQUAL(21, right.result().on_wall_count);
+  DOUBLES_EQUAL(1.0, right.result().share(), 0.0);
+  // One cell off still counts (the tolerance); four cells off does not.
+  MapAgreement near(map, 0.65);
+  near.add_scan(Pose2{0.05, 0.0, 0.0}, *scan);
+  LONGS_EQUAL(21, near.result().on_wall_count);
+  MapAgreement shifted(map, 0.65);
+  shifted.add_scan(Pose2{0.2, 0.0, 0.0}, *scan);
+  LONGS_EQUAL(21, shifted.result().return_count);
+  LONGS_EQUAL(0, shifted.result().on_wall_count);
+  // The laser's mounting is applied: mounted 0.2 m behind the centre of a robot standing
+  // 0.2 m ahead, the laser is at the origin again and its returns land on the wall.
+  auto mounted = scan_of_wall();
+  mounted->geometry.laser_in_base = Pose2{-0.2, 0.0, 0.0};
+  MapAgreement m(map, 0.65);
+  m.add_scan(Pose2{0.2, 0.0, 0.0}, *mounted);
+  LONGS_EQUAL(21, m.result().on_wall_count);
+  // Returns off the image count as off the walls.
+  MapAgreement outside(map, 0.65);
+  outside.add_scan(Pose2{10.0, 10.0, 0.0}, *scan);
+  LONGS_EQUAL(21, outside.result().return_count);
+  LONGS_EQUAL(0, outside.result().on_wall_count);
+}
+
+TEST_GROUP(MapRead) {
+  std::string dir;
+  void setup() override { dir = sdpslam::test::make_temp_dir("map-read"); }
+  void teardown() override {
+    for (const char* f : {"/m.pgm", "/m.yaml", "/bad.yaml", "/short.pgm", "/short.yaml"}) ::unlink((dir + f).c_str());
+    ::rmdir(dir.c_str());
+  }
+  std::string put(const char* name, const std::string& text) {
+    std::string error;
+    const std::string p = dir + "/" + name;
+    CHECK_TRUE(sdpslam::io::write_file_atomic(p, text, &error));
+    return p;
+  }
+};
+
+TEST(MapRead, gives_back_what_the_writer_wrote) {
+  OccupancyImage m;
+  m.width = 3U;
+  m.height = 2U;
+  m.resolution_m = 0.1;
+  m.origin_x_m = -1.5;
+  m.origin_y_m = 2.25;
+  m.occupancy = {1.0F, 0.0F, -1.0F, 0.8F, 0.1F, 0.4F};  // 0.4 lies between the thresholds: unknown
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::write_map_pgm_yaml(dir + "/m", m, MapWriteOptions{}, &error), error.c_str());
+  OccupancyImage r;
+  MapWriteOptions t;
+  t.occupied_thresh = 0.0;
+  CHECK_TRUE_TEXT(sdpslam::io::read_map_pgm_yaml(dir + "/m.yaml", &r, &t, &error), error.c_str());
+  LONGS_EQUAL(3, r.width);
+  LONGS_EQUAL(2, r.height);
+  DOUBLES_EQUAL(0.1, r.resolution_m, 1e-12);
+  DOUBLES_EQUAL(-1.5, r.origin_x_m, 1e-12);
+  DOUBLES_EQUAL(2.25, r.origin_y_m, 1e-12);
+  DOUBLES_EQUAL(0.65, t.occupied_thresh, 1e-12);
+  const float expect[] = {1.0F, 0.0F, -1.0F, 0.8F, 0.1F, -1.0F};
+  for (std::size_t i = 0; i < 6U; ++i) DOUBLES_EQUAL(expect[i], r.occupancy[i], 1.0 / 255.0);
+}
+
+TEST(MapRead, names_the_file_and_line_of_what_it_cannot_read) {
+  OccupancyImage r;
+  std::string error;
+  const std::string bad = put("bad.yaml", "image: m.pgm\nresolution: -1\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(bad, &r, nullptr, &error));
+  STRCMP_CONTAINS("bad.yaml:2: resolution must be > 0", error.c_str());
+  put("bad.yaml", "image: m.pgm\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(bad, &r, nullptr, &error));
+  STRCMP_CONTAINS("no 'resolution' key", error.c_str());
+  put("short.pgm", std::string("P5\n4 4\n255\n") + std::string(10U, '\xff'));
+  const std::string shrt = put("short.yaml", "image: short.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(shrt, &r, nullptr, &error));
+  STRCMP_CONTAINS("short.pgm: image data short: 10 of 16 bytes", error.c_str());
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(dir + "/none.yaml", &r, nullptr, &error));
+  STRCMP_CONTAINS("none.yaml: cannot open", error.c_str());
+}
