@@ -79,9 +79,12 @@ struct SdpOptions {
   bool defer_top_work = false;
   // [sdp] fixed memory of the shared DP map in SDP mode (0 = keep the [map] values):
   // tiles that may hold data and observations for every live submap (the permanent
-  // submaps go to the permanent map below).
-  std::uint32_t map_tile_capacity = 4000U;
-  std::uint32_t map_observation_capacity = 1460000U;
+  // submaps go to the permanent map below). Tiles peak at ~900 (Intel) and ~1300
+  // (ACES); the rest of the 64 MiB goes to observations, which ACES can still run short
+  // of: seed 9 needs 1.57 M (0.068 m with them all, 0.070 m at 1.505 M, 0.106 m at
+  // 1.46 M). Every refused update is counted (stats.json pools.observations).
+  std::uint32_t map_tile_capacity = 2500U;
+  std::uint32_t map_observation_capacity = 1505000U;
   // [sdp] tiles of the global map's permanent part (permanent_map.h), 16 × 16 cells of
   // 8 bytes each (2 KiB), over the DP map's area (at most the area's tiles are
   // provisioned). A copy into a full map is refused and counted (map_transfer_dropped).
