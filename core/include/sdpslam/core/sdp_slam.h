@@ -224,7 +224,10 @@ class SdpSlam {
   // f(x_m, y_m, value) for every cell of the global map's permanent part: the centre of
   // the cell in the global frame, moved by the correction its level's frame got since
   // the cell was copied (frame_now ⊕ frame_at_copy⁻¹). A cell of a level that left the
-  // ring of permanent submaps (max_permanent_submaps) stays where it was copied.
+  // ring of permanent submaps (max_permanent_submaps) stays where it was copied: its
+  // correction at the time it left is not kept (that would cost a pose per level for
+  // ever). Moving it with the oldest submap still held instead was measured worse
+  // (SdpSlam test forgotten_permanent_levels_stay_where_they_were_copied).
   template <class F>
   void for_each_permanent_cell(F&& f) const;
   const PermanentMap& permanent_map() const { return permanent_map_; }
@@ -587,7 +590,7 @@ void SdpSlam::for_each_permanent_cell(F&& f) const {
       last_tag = c.tag;
       correction = Pose2{};
       const std::uint32_t level = c.tag - 1U;
-      if (level >= first_level && level - first_level < perm_count_) {
+      if (perm_count_ > 0U && level >= first_level && level - first_level < perm_count_) {
         const Permanent& pm = perm_[(perm_head_ + (level - first_level)) % options_.max_permanent_submaps];
         correction = pm.frame_in_global.compose(pm.frame_in_map.inverse());
       }
