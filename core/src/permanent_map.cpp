@@ -46,13 +46,11 @@ bool PermanentMap::init(Arena& arena, std::int32_t width_cells, std::int32_t hei
 }
 
 bool PermanentMap::add(std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses, std::uint32_t tag) {
-  if (table_ == nullptr || tag == 0U || ix < 0 || iy < 0 || ix >= width_cells_ || iy >= height_cells_) {
+  if (tag == 0U || !in_area(ix, iy)) {
     ++refused_out_of_area_;
     return false;
   }
-  const auto ux = static_cast<std::uint32_t>(ix);
-  const auto uy = static_cast<std::uint32_t>(iy);
-  std::uint32_t& slot = table_[(uy >> kSideLog2) * tiles_x_ + (ux >> kSideLog2)];
+  std::uint32_t& slot = tile_slot(ix, iy);
   if (slot == kNone) {
     if (tiles_used_ == tile_capacity_) {
       ++refused_no_tile_;
@@ -62,7 +60,7 @@ bool PermanentMap::add(std::int32_t ix, std::int32_t iy, std::uint16_t hits, std
     Cell* tile = cells_ + static_cast<std::size_t>(slot) * kCells;
     for (std::uint32_t i = 0; i < kCells; ++i) tile[i] = Cell{};
   }
-  Cell& c = cells_[static_cast<std::size_t>(slot) * kCells + ((uy & (kSide - 1U)) << kSideLog2) + (ux & (kSide - 1U))];
+  Cell& c = cell_in(slot, ix, iy);
   const std::uint32_t before = static_cast<std::uint32_t>(c.value.hits) + c.value.misses;
   const std::uint32_t added = static_cast<std::uint32_t>(hits) + misses;
   if (c.tag == 0U) ++known_cells_;
@@ -72,12 +70,9 @@ bool PermanentMap::add(std::int32_t ix, std::int32_t iy, std::uint16_t hits, std
 }
 
 PermanentMap::Cell PermanentMap::cell(std::int32_t ix, std::int32_t iy) const {
-  if (table_ == nullptr || ix < 0 || iy < 0 || ix >= width_cells_ || iy >= height_cells_) return Cell{};
-  const auto ux = static_cast<std::uint32_t>(ix);
-  const auto uy = static_cast<std::uint32_t>(iy);
-  const std::uint32_t slot = table_[(uy >> kSideLog2) * tiles_x_ + (ux >> kSideLog2)];
-  if (slot == kNone) return Cell{};
-  return cells_[static_cast<std::size_t>(slot) * kCells + ((uy & (kSide - 1U)) << kSideLog2) + (ux & (kSide - 1U))];
+  if (!in_area(ix, iy)) return Cell{};
+  const std::uint32_t slot = tile_slot(ix, iy);
+  return slot == kNone ? Cell{} : cell_in(slot, ix, iy);
 }
 
 }  // namespace sdpslam

@@ -191,6 +191,22 @@ double permanent_map_agreement(const SdpSlam& slam, const test::ScanSet& set, co
   }
   return all > 0U ? static_cast<double>(hit) / static_cast<double>(all) : 0.0;
 }
+
+// One run with the wide loop search; checks the PGS and that every search has exactly
+// one outcome (held peaks that no second pair corroborated are an outcome of their own).
+SdpStats run_loop_search(const test::ScanSet& set, const SdpOptions& o, double* error_m) {
+  test::SdpRig r;
+  CHECK_TRUE(r.init(test::sim_options(5), o, 21));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(r, set, &sink);
+  if (error_m != nullptr) *error_m = mean_error_to_truth(t, set);
+  CHECK_TRUE(r.slam->graph().invariants_hold());
+  const SdpStats st = r.slam->stats();
+  LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
+                                    st.loop_search_refuted + st.loop_search_closed +
+                                    (st.loop_search_held - st.loop_search_corroborated));
+  return st;
+}
 }  // namespace
 
 // Beyond the paper: loop constraints found, the best combination's frames adjusted (the
@@ -319,19 +335,7 @@ TEST(SdpSlam, weak_search_peaks_close_loops_only_when_a_second_older_submap_agre
   s.loop_search_window_m = 3.0;
   s.loop_search_min_score = 1.0;
   s.loop_search_confirm_score = 0.4;
-  auto run = [&](const SdpOptions& o, double* error_m) {
-    test::SdpRig r;
-    CHECK_TRUE(r.init(test::sim_options(5), o, 21));
-    test::CollectPoses sink;
-    const Trace t = run_sdp(r, set, &sink);
-    if (error_m != nullptr) *error_m = mean_error_to_truth(t, set);
-    CHECK_TRUE(r.slam->graph().invariants_hold());
-    const SdpStats st = r.slam->stats();
-    LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
-                                      st.loop_search_refuted + st.loop_search_closed +
-                                      (st.loop_search_held - st.loop_search_corroborated));
-    return st;
-  };
+  auto run = [&](const SdpOptions& o, double* error_m) { return run_loop_search(set, o, error_m); };
   double agreed_m = 0.0;
   const SdpStats a = run(s, &agreed_m);
   CHECK(a.loop_search_held > 0U);
@@ -365,16 +369,7 @@ TEST(SdpSlam, far_search_peaks_close_loops_only_when_a_second_older_submap_agree
   s.loop_closure = true;
   s.loop_search_window_m = 3.0;
   auto run = [&](const SdpOptions& o, double* error_m) {
-    test::SdpRig r;
-    CHECK_TRUE(r.init(test::sim_options(5), o, 21));
-    test::CollectPoses sink;
-    const Trace t = run_sdp(r, set, &sink);
-    *error_m = mean_error_to_truth(t, set);
-    CHECK_TRUE(r.slam->graph().invariants_hold());
-    const SdpStats st = r.slam->stats();
-    LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
-                                      st.loop_search_refuted + st.loop_search_closed +
-                                      (st.loop_search_held - st.loop_search_corroborated));
+    const SdpStats st = run_loop_search(set, o, error_m);
     CHECK(st.loop_search_far <= st.loop_search_held);
     return st;
   };

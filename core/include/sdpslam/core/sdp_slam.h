@@ -590,7 +590,7 @@ void SdpSlam::for_each_permanent_cell(F&& f) const {
       last_tag = c.tag;
       correction = Pose2{};
       const std::uint32_t level = c.tag - 1U;
-      if (perm_count_ > 0U && level >= first_level && level - first_level < perm_count_) {
+      if (level >= first_level && level - first_level < perm_count_) {
         const Permanent& pm = perm_[(perm_head_ + (level - first_level)) % options_.max_permanent_submaps];
         correction = pm.frame_in_global.compose(pm.frame_in_map.inverse());
       }
