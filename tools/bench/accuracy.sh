@@ -1,0 +1,225 @@
+#!/bin/sh
+# Accuracy benchmark: every real log that has ground truth and every built-in simulated
+# world, each run once per seed with the same options, so that a change is judged by its
+# mean and its worst seed rather than by one lucky run.
+#   - logs: `sdpslam run LOG --seed S`, then the relations metric (`sdpslam evaluate
+#     --relations`, mean absolute translational error, m);
+#   - worlds: `sdpslam simulate --seed S` (the seed also draws the sensor noise, so each
+#     seed is a different simulated run), `sdpslam run --seed S` on it, then the absolute
+#     trajectory error against the simulator's ground truth (ATE RMSE after SE(2)
+#     alignment, m). `simulate` has one built-in world, the paper's nested loops: "paper".
+# From each run's stats.json: CPU seconds of the whole run, worst per-scan CPU time, the
+# arena declared at init (the state's size), peak RSS, and the refusals (pools.*.exhausted,
+# pools.*.refused, pools.*.dropped, out_of_map_updates: capacity running out, which the
+# core survives by dropping work).
+# Every (log or world, seed) pair is one job in its own folder OUT_DIR/{logs,worlds}/NAME/S
+# (run.log, evaluate.json, stats.json, record.tsv); JOBS of them run at once. A failed run
+# or evaluation is recorded as NA, the rest go on, and the script exits 1 after printing
+# the table. Prints one markdown table (a row per log / world) on stdout and writes it to
+# OUT_DIR/accuracy.md, every job's record to OUT_DIR/runs.tsv; progress goes to stderr.
+# Needs python3 (reads the JSON) and xargs -P.
+#
+#   tools/bench/accuracy.sh BUILD_DIR [OUT_DIR]
+#   e.g. tools/bench/accuracy.sh build/host-release /tmp/sdpslam-accuracy
+#        SEEDS="1 2" LOGS=aces WORLDS= RUN_ARGS="--profile paper" tools/bench/accuracy.sh build/host-release
+#
+# Environment: SEEDS (default "1 2 3 4 5"), JOBS (runs at once, default nproc), SHARED
+# (default ../shared beside the checkout), LOGS (default: every NAME in $SHARED/datasets
+# with a NAME.relations and a NAME.clf or NAME.clf.gz; LOGS="" runs none), WORLDS
+# (default "paper"; WORLDS="" runs none), RUN_ARGS (appended to every `sdpslam run`,
+# e.g. "--profile paper" or "--config my.ini"; default none). Use a Release build.
+# Without $SHARED/datasets only the worlds run. Default OUT_DIR: /tmp/sdpslam-accuracy.
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+self="$here/$(basename "$0")"
+
+# One job: `accuracy.sh --job log|world NAME SEED` (run by xargs below, settings in ACC_*).
+# Writes DIR/record.tsv; exits 0 whether or not the run and evaluation succeeded.
+if [ "${1:-}" = --job ]; then
+  kind=$2; name=$3; seed=$4
+  bin=$ACC_BIN
+  dir="$ACC_OUT/${kind}s/$name/$seed"
+  rm -rf "$dir"; mkdir -p "$dir"
+  echo "   start $name seed $seed -> $dir" >&2
+  status=ok
+  if [ "$kind" = log ]; then
+    log=$ACC_SHARED/datasets/$name.clf
+    [ -f "$log" ] || log=$log.gz
+    metric="relations m"
+  else
+    metric="ATE m"
+    if "$bin" simulate --seed "$seed" --out "$dir/sim" > "$dir/simulate.log" 2>&1; then
+      log=$dir/sim/sim.clf
+    else
+      status=simulate_failed
+    fi
+  fi
+  if [ "$status" = ok ]; then
+    set -f  # RUN_ARGS is split into words, never globbed
+    # shellcheck disable=SC2086
+    if "$bin" run "$log" --seed "$seed" --out "$dir" $ACC_RUN_ARGS > "$dir/run.log" 2>&1; then :; else
+      status="run_failed(exit $?)"
+    fi
+    set +f
+  fi
+  if [ "$status" = ok ]; then
+    if [ "$kind" = log ]; then
+      set -- --log "$log" --relations "$ACC_SHARED/datasets/$name.relations"
+    else
+      set -- --ground-truth "$dir/sim/ground_truth.txt"
+    fi
+    if "$bin" evaluate "$@" --trajectory "$dir/trajectory.txt" --json "$dir/evaluate.json" \
+         > "$dir/evaluate.txt" 2>&1; then :; else
+      status="evaluate_failed(exit $?)"
+    fi
+  fi
+  python3 - "$kind" "$name" "$seed" "$metric" "$status" "$dir" > "$dir/record.tsv.tmp" <<'EOF' ||
+import json, os, sys
+kind, name, seed, metric, status, d = sys.argv[1:]
+def load(f):
+    try:
+        with open(os.path.join(d, f)) as fh:
+            return json.load(fh)
+    except (OSError, ValueError):
+        return None
+value = "NA"
+ev = load("evaluate.json") if status == "ok" else None
+if status == "ok":
+    try:
+        value = repr(ev["relations"]["translation_m"]["mean"] if kind == "log" else ev["ate"]["rmse_m"])
+    except (TypeError, KeyError):
+        status = "evaluate_unreadable"
+st = load("stats.json") or {}
+t, m, pools = st.get("timing", {}), st.get("memory", {}), st.get("pools", {})
+def get(o, k):
+    return "NA" if k not in o else str(o[k])
+kinds = []
+for pool, v in pools.items():
+    if isinstance(v, dict):
+        kinds += [("%s.%s" % (pool, k), v[k]) for k in ("exhausted", "refused", "dropped") if k in v]
+# map_updates_dropped and global_map_updates_dropped repeat the observation and
+# permanent-map pools' exhausted counts (the same refusals): not added again.
+for k in ("out_of_map_updates",):
+    if k in pools:
+        kinds.append((k, pools[k]))
+refusals = str(sum(n for _, n in kinds)) if st else "NA"
+nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
+print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
+                 get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d]))
+EOF
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\n' \
+    "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
+  mv "$dir/record.tsv.tmp" "$dir/record.tsv"
+  value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
+  if [ "$status" = ok ]; then
+    echo "   done  $name seed $seed: $metric $value (cpu $(cut -f7 "$dir/record.tsv") s)" >&2
+  else
+    echo "   FAIL  $name seed $seed: $status, see $dir" >&2
+  fi
+  exit 0
+fi
+
+root=$(cd "$here/../.." && pwd)
+build=${1:?usage: accuracy.sh BUILD_DIR [OUT_DIR]}
+out=${2:-/tmp/sdpslam-accuracy}
+seeds=${SEEDS:-"1 2 3 4 5"}
+jobs=${JOBS:-$(nproc 2>/dev/null || getconf _NPROCESSORS_ONLN 2>/dev/null || echo 1)}
+shared=${SHARED:-$root/../shared}
+worlds=${WORLDS-paper}
+run_args=${RUN_ARGS:-}
+bin="$build/tools/cli/sdpslam"
+[ -x "$bin" ] || { echo "accuracy.sh: no sdpslam binary in $build" >&2; exit 2; }
+command -v python3 > /dev/null || { echo "accuracy.sh: needs python3 (apt-get install python3)" >&2; exit 2; }
+case $jobs in ''|*[!0-9]*|0) echo "accuracy.sh: JOBS must be a positive integer, not '$jobs'" >&2; exit 2;; esac
+[ -n "$seeds" ] || { echo "accuracy.sh: SEEDS is empty" >&2; exit 2; }
+for s in $seeds; do
+  case $s in *[!0-9]*) echo "accuracy.sh: seeds are non-negative integers, not '$s'" >&2; exit 2;; esac
+done
+for w in $worlds; do
+  [ "$w" = paper ] || { echo "accuracy.sh: unknown world '$w' (sdpslam simulate has one built-in world: paper)" >&2; exit 2; }
+done
+
+# has_log NAME: the dataset has ground-truth relations and a CARMEN log.
+has_log() {
+  [ -f "$shared/datasets/$1.relations" ] || return 1
+  [ -f "$shared/datasets/$1.clf" ] || [ -f "$shared/datasets/$1.clf.gz" ]
+}
+if [ ! -d "$shared/datasets" ]; then
+  echo "accuracy.sh: no datasets in $shared/datasets (set SHARED): running the simulated worlds only" >&2
+  logs=""
+elif [ "${LOGS+set}" = set ]; then
+  logs=$LOGS
+  for l in $logs; do
+    has_log "$l" || { echo "accuracy.sh: log '$l' needs $shared/datasets/$l.relations and $l.clf or $l.clf.gz" >&2; exit 2; }
+  done
+else
+  logs=""
+  for r in "$shared/datasets"/*.relations; do
+    [ -f "$r" ] || continue
+    l=$(basename "$r" .relations)
+    if has_log "$l"; then logs="${logs:+$logs }$l"; fi
+  done
+fi
+mkdir -p "$out"
+joblist="$out/jobs.txt"
+: > "$joblist"
+for l in $logs; do for s in $seeds; do echo "log $l $s" >> "$joblist"; done; done
+for w in $worlds; do for s in $seeds; do echo "world $w $s" >> "$joblist"; done; done
+[ -s "$joblist" ] || { echo "accuracy.sh: nothing to run (no logs, WORLDS empty)" >&2; exit 2; }
+echo "== accuracy: $(wc -l < "$joblist") jobs, $jobs at a time; logs: ${logs:-none}; worlds: ${worlds:-none};" \
+  "seeds: $seeds; RUN_ARGS: ${run_args:-none}; outputs in $out" >&2
+
+ACC_BIN=$bin ACC_OUT=$out ACC_SHARED=$shared ACC_RUN_ARGS=$run_args
+export ACC_BIN ACC_OUT ACC_SHARED ACC_RUN_ARGS
+xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job ended abnormally" >&2
+
+# runs.tsv in job order; a job that left no record counts as failed.
+runs="$out/runs.tsv"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\n' > "$runs"
+while read -r kind name seed; do
+  rec="$out/${kind}s/$name/$seed/record.tsv"
+  if [ -f "$rec" ]; then cat "$rec"; else
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\n' "$kind" "$name" "$seed" "${rec%/*}"
+  fi
+done < "$joblist" >> "$runs"
+
+python3 - "$runs" "$out/accuracy.md" <<'EOF'
+import sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1])]
+head, rows = rows[0], [dict(zip(rows[0], r)) for r in rows[1:]]
+groups = {}
+for r in rows:
+    groups.setdefault((r["kind"], r["name"]), []).append(r)
+def num(v):
+    return None if v == "NA" else float(v)
+def fmt(v, f):
+    return "NA" if v is None else f % v
+def nums(rs, k):
+    return [x for x in (num(r[k]) for r in rs) if x is not None]
+out = ["| name | metric | mean | worst (seed) | per seed | CPU s mean | CPU s max | worst scan ms "
+       "| state bytes | peak RSS MiB | refusals |",
+       "|---|---|---|---|---|---|---|---|---|---|---|"]
+for (kind, name), rs in groups.items():
+    metric = "relations m" if kind == "log" else "ATE m"
+    ok = [(num(r["value_m"]), r["seed"]) for r in rs if num(r["value_m"]) is not None]
+    mean = sum(v for v, _ in ok) / len(ok) if ok else None
+    mean_s = fmt(mean, "%.3f") + ("" if len(ok) == len(rs) else " (%d of %d)" % (len(ok), len(rs)))
+    worst = "NA" if not ok else "%.3f (%s)" % max(ok, key=lambda vs: vs[0])
+    per = ", ".join("%s: %s" % (r["seed"], fmt(num(r["value_m"]), "%.3f")) for r in rs)
+    cpu = nums(rs, "cpu_time_s")
+    scan, arena, rss, ref = (nums(rs, k) for k in ("scan_cpu_ms_max", "arena_bytes", "peak_rss_kib", "refusals"))
+    kinds = sorted({k.split("=")[0] for r in rs if r["refusal_kinds"] != "-" for k in r["refusal_kinds"].split(",")})
+    refs = "NA" if not ref else "%d" % sum(ref) + (" (%s)" % ", ".join(kinds) if kinds else "")
+    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per,
+        fmt(sum(cpu) / len(cpu) if cpu else None, "%.1f"), fmt(max(cpu) if cpu else None, "%.1f"),
+        fmt(max(scan) if scan else None, "%.1f"), fmt(max(arena) if arena else None, "%d"),
+        fmt(max(rss) / 1024 if rss else None, "%.1f"), refs]))
+text = "\n".join(out) + "\n"
+open(sys.argv[2], "w").write(text)
+sys.stdout.write(text)
+EOF
+failed=$(awk -F '\t' 'NR > 1 && $6 != "ok"' "$runs" | wc -l)
+if [ "$failed" -gt 0 ]; then
+  echo "accuracy.sh: $failed of $(wc -l < "$joblist") jobs failed (NA above); see status in $runs" >&2
+  exit 1
+fi
