@@ -317,3 +317,70 @@ TEST(LogReader, reader_can_be_reopened_on_another_file) {
   CHECK(r.next() == LogReader::Next::kOdom);
   CHECK_EQUAL(0U, r.error_count());
 }
+
+namespace {
+std::string odom_tv(const std::string& pose, const std::string& tv_mps, const std::string& stamp) {
+  return "ODOM " + pose + " " + tv_mps + " 0 0 " + stamp + " nohost 0";
+}
+}  // namespace
+
+// A base that integrates |v| reports a forward increment while its measured velocity
+// says the robot reversed: the increment is mirrored, later poses follow the repaired
+// chain, and a laser's odometry pose moves with the correction of the last ODOM.
+TEST(LogReader, odometry_advancing_against_a_negative_velocity_is_mirrored) {
+  ScratchDir dir("io-reverse");
+  std::string s;
+  s += odom_tv("0 0 0", "0.5", "100.0") + "\n";
+  s += odom_tv("1 0 0", "0.5", "100.1") + "\n";    // forward, as measured
+  s += odom_tv("2 0 0.1", "-0.5", "100.2") + "\n";  // "forward" while reversing: mirrored
+  s += flaser_line(3, "1.0", "2.5 0 0.1", "100.25") + "\n";
+  s += odom_tv("3 0 0.1", "-0.5", "100.3") + "\n";  // mirrored again (in the turned frame)
+  s += odom_tv("4 0 0.1", "0.5", "100.4") + "\n";   // forward again, as measured
+  const std::string path = dir.write("rev.clf", s);
+  LogReader reader;
+  std::string error;
+  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  std::vector<sdpslam::Pose2> odoms;
+  std::vector<sdpslam::Pose2> lasers;
+  for (LogReader::Next n = reader.next(); n != LogReader::Next::kEnd; n = reader.next()) {
+    if (n == LogReader::Next::kOdom) odoms.push_back(reader.odom().pose);
+    if (n == LogReader::Next::kLaser) lasers.push_back(reader.laser().odom_pose);
+  }
+  CHECK_EQUAL(2U, reader.odometry_reversals_repaired());
+  CHECK_EQUAL(0U, reader.error_count());
+  CHECK_EQUAL(5U, odoms.size());
+  CHECK_EQUAL(1U, lasers.size());
+  DOUBLES_EQUAL(1.0, odoms[1].x_m, 1e-12);
+  DOUBLES_EQUAL(0.0, odoms[2].x_m, 1e-12);  // 1 - 1
+  DOUBLES_EQUAL(0.0, odoms[2].y_m, 1e-12);
+  DOUBLES_EQUAL(0.1, odoms[2].heading_rad, 1e-12);
+  // Step 3 is 1 m along x in the log's frame, i.e. (cos 0.1, -sin 0.1) in the frame of
+  // the pose at 100.2; mirrored, it goes back along the same line.
+  DOUBLES_EQUAL(-1.0, odoms[3].x_m, 1e-12);
+  DOUBLES_EQUAL(0.0, odoms[3].y_m, 1e-12);
+  DOUBLES_EQUAL(0.0, odoms[4].x_m, 1e-12);  // forward 1 m again
+  DOUBLES_EQUAL(0.1, odoms[4].heading_rad, 1e-12);
+  // The laser at 100.25: 0.5 m ahead of the raw ODOM at 100.2, kept as written, on the
+  // repaired pose of that ODOM.
+  DOUBLES_EQUAL(0.5, lasers[0].x_m, 1e-12);
+  DOUBLES_EQUAL(0.0, lasers[0].y_m, 1e-12);
+}
+
+// Poses that agree with their velocity (or carry none: tv = 0, as in most converted
+// logs) are returned exactly as written, bit for bit.
+TEST(LogReader, self_consistent_odometry_is_returned_as_written) {
+  ScratchDir dir("io-consistent");
+  std::string s;
+  s += odom_tv("0.3 0.7 0.2", "0.5", "100.0") + "\n";
+  s += odom_tv("0.1 0.65 0.2", "-0.4", "100.1") + "\n";  // backwards, as measured
+  s += odom_tv("1.1 0.9 0.3", "0", "100.2") + "\n";     // no velocity measured
+  s += flaser_line(3, "1.0", "1.2 0.95 0.3", "100.25") + "\n";
+  const LogContents c = read_all(dir.write("ok.clf", s));
+  CHECK_EQUAL(3U, c.odoms.size());
+  CHECK_EQUAL(1U, c.lasers.size());
+  CHECK_EQUAL(0.1, c.odoms[1].pose.x_m);
+  CHECK_EQUAL(0.65, c.odoms[1].pose.y_m);
+  CHECK_EQUAL(1.1, c.odoms[2].pose.x_m);
+  CHECK_EQUAL(1.2, c.lasers[0].odom_pose.x_m);
+  CHECK_EQUAL(0.95, c.lasers[0].laser_pose.y_m);
+}

@@ -179,6 +179,8 @@ LogReader::Next parse_flaser(const Fields& f, bool rear, const LogReaderOptions&
   laser->has_stamp = true;
   laser->has_laser_pose = true;
   laser->has_odom_pose = true;
+  laser->has_tv = false;  // FLASER/RLASER carry no velocity
+  laser->tv_mps = 0.0;
   return LogReader::Next::kLaser;
 }
 
@@ -248,7 +250,9 @@ LogReader::Next parse_robotlaser(const Fields& f, LaserRecord* laser, std::strin
       *reason = "velocity/safety field " + std::to_string(i + 1) + " is not a finite number: " + quote(f[i]);
       return LogReader::Next::kEnd;
     }
+    if (i == p + 6) laser->tv_mps = v;  // laser_tv
   }
+  laser->has_tv = true;
   if (!parse_trailer(f, &laser->stamp_us, &laser->logger_stamp_us, reason)) return LogReader::Next::kEnd;
   scan.geometry.angle_min_rad = cfg[0];
   scan.geometry.angle_increment_rad = cfg[2];

@@ -179,6 +179,55 @@ struct LogReader::Impl {
   bool dp_have_odom = false;
   Pose2 dp_odom;
 
+  // Reversed-odometry repair (LogReader::next()): the last velocity-carrying pose as
+  // written and as repaired, and its velocity.
+  bool repair_latched = false;
+  bool repair_active = false;  // a repair happened: poses go through the repaired chain
+  Pose2 repair_last_raw;
+  Pose2 repair_last_pose;
+  std::size_t repairs = 0;
+
+  static bool against_velocity(const Pose2& d, double tv_mps) {
+    return (tv_mps < 0.0 && d.x_m > 0.0) || (tv_mps > 0.0 && d.x_m < 0.0);
+  }
+  static Pose2 mirrored(const Pose2& d) { return Pose2{-d.x_m, -d.y_m, d.heading_rad}; }
+
+  // A pose with its measured velocity: advances the chain.
+  Pose2 repair_with_velocity(const Pose2& raw, double tv_mps) {
+    Pose2 out = raw;
+    if (repair_latched) {
+      Pose2 d = between(repair_last_raw, raw);
+      if (against_velocity(d, tv_mps)) {
+        d = mirrored(d);
+        ++repairs;
+        repair_active = true;
+      }
+      if (repair_active) out = repair_last_pose.compose(d);
+    }
+    repair_latched = true;
+    repair_last_raw = raw;
+    repair_last_pose = out;
+    return out;
+  }
+  // A pose without a velocity (a laser's odometry pose): moved with the correction of
+  // the last velocity-carrying pose. Its small offset from that pose is kept as written:
+  // the laser may be stamped before or after it, so that offset is not a motion the
+  // velocity measured.
+  Pose2 repair_without_velocity(const Pose2& raw) const {
+    if (!repair_active) return raw;
+    return repair_last_pose.compose(between(repair_last_raw, raw));
+  }
+  void repair_record(Next got) {
+    if (got == Next::kOdom) {
+      odom.pose = repair_with_velocity(odom.pose, odom.tv_mps);
+      return;
+    }
+    if (got != Next::kLaser || !laser.has_odom_pose) return;
+    const Pose2 raw = laser.odom_pose;
+    laser.odom_pose = laser.has_tv ? repair_with_velocity(raw, laser.tv_mps) : repair_without_velocity(raw);
+    if (repair_active && laser.has_laser_pose) laser.laser_pose = laser.odom_pose.compose(between(raw, laser.laser_pose));
+  }
+
   void add_error(std::int64_t at_line, std::string why, bool warning) {
     ++error_count;
     if (warning) ++warning_count;
@@ -414,6 +463,7 @@ LogReader::Next LogReader::next() {
       continue;
     }
     if (got == Next::kEnd) continue;  // an ignored message type
+    if (s.format == LogFormat::kCarmen) s.repair_record(got);
     switch (got) {
       case Next::kLaser: s.laser.line = s.line_no; break;
       case Next::kOdom: s.odom.line = s.line_no; break;
@@ -439,6 +489,7 @@ LogFormat LogReader::format() const { return impl_->format; }
 const std::vector<LogError>& LogReader::errors() const { return impl_->errors; }
 std::size_t LogReader::error_count() const { return impl_->error_count; }
 std::size_t LogReader::warning_count() const { return impl_->warning_count; }
+std::size_t LogReader::odometry_reversals_repaired() const { return impl_->repairs; }
 std::int64_t LogReader::lines_read() const { return impl_->line_no; }
 std::uint64_t LogReader::input_offset() const { return impl_->source.offset(); }
 

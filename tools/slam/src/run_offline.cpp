@@ -118,6 +118,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(st.processed) + ",\n";
   js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
+  js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
   js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
   js += "  \"proposal\": {\"matched\": " + u(st.proposal_matched) + ", \"fallback_few_beams\": " +
         u(st.proposal_fallback_few_beams) + ", \"fallback_empty_map\": " + u(st.proposal_fallback_empty_map) +
@@ -147,6 +148,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     summary->scans = scans.size();
     summary->processed = st.processed;
     summary->log_error_count = reader.error_count();
+    summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
     summary->wall_time_s = wall_s;
   }
   return RunStatus::kOk;

@@ -376,6 +376,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(bs.processed) + ",\n";
   js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
+  js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
   js += sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells);
   js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
         fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
@@ -399,6 +400,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->processed = bs.processed;
     summary->segments = st.segments;
     summary->log_error_count = reader.error_count();
+    summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
     summary->wall_time_s = wall_s;
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();

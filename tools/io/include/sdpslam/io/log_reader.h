@@ -48,6 +48,8 @@ struct LaserRecord {
   bool has_laser_pose = false;
   Pose2 odom_pose;                  // robot odometry pose at the scan
   bool has_odom_pose = false;
+  double tv_mps = 0.0;              // ROBOTLASER1: the measured translational velocity
+  bool has_tv = false;
   std::int64_t line = 0;
 };
 
@@ -109,6 +111,18 @@ class LogReader {
   bool open(const std::string& path, const LogReaderOptions& options, std::string* error);
 
   // Advances to the next good record, skipping (and recording) malformed lines.
+  //
+  // Reversed odometry (CARMEN): ODOM and ROBOTLASER1 carry the integrated odometry pose
+  // and, beside it, the measured translational velocity tv. Some bases integrate the
+  // speed's magnitude, so while the robot drives backwards (tv < 0) their pose still
+  // advances along its heading: the two measurements of one motion disagree in sign,
+  // and SLAM fed that pose builds its map a metre off after every reverse manoeuvre.
+  // The velocity is the direct measurement, so an increment between consecutive
+  // velocity-carrying poses whose forward component has the opposite sign of tv is
+  // mirrored (-dx, -dy, same turn) and counted (odometry_reversals_repaired()). From the
+  // first repair on, every odometry pose the reader returns (ODOM, and the odometry and
+  // laser poses of FLASER, RLASER and ROBOTLASER1) is placed on the repaired chain; the
+  // poses of a log that never contradicts itself are returned exactly as written.
   Next next();
 
   // The current record; valid until the next call to next().
@@ -120,6 +134,9 @@ class LogReader {
   const std::vector<LogError>& errors() const;
   std::size_t error_count() const;    // every skipped line, warnings included
   std::size_t warning_count() const;  // the part of error_count() that are warnings
+  // Odometry increments mirrored because they ran against the log's own measured
+  // velocity (see LogReader::next()); 0 for a log whose odometry is self-consistent.
+  std::size_t odometry_reversals_repaired() const;
   std::int64_t lines_read() const;
   // Bytes of the input file consumed so far (compressed bytes for .gz), for progress.
   std::uint64_t input_offset() const;

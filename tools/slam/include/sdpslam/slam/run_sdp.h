@@ -43,6 +43,7 @@ struct SdpRunSummary {
   std::uint64_t processed = 0U;
   std::uint64_t segments = 0U;
   std::size_t log_error_count = 0U;
+  std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
   double wall_time_s = 0.0;
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
