@@ -99,9 +99,8 @@ for pool, v in pools.items():
         kinds += [("%s.%s" % (pool, k), v[k]) for k in ("exhausted", "refused", "dropped") if k in v]
 # map_updates_dropped and global_map_updates_dropped repeat the observation and
 # permanent-map pools' exhausted counts (the same refusals): not added again.
-for k in ("out_of_map_updates",):
-    if k in pools:
-        kinds.append((k, pools[k]))
+if "out_of_map_updates" in pools:
+    kinds.append(("out_of_map_updates", pools["out_of_map_updates"]))
 refusals = str(sum(n for _, n in kinds)) if st else "NA"
 nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),

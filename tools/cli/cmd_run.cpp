@@ -36,8 +36,6 @@ int report(const char* what, int code, const std::string& error) {
   return code;
 }
 
-// `config` holds the profile's bottom-level options with the file's keys on top; `sdp`
-// the profile's top-level options, the file's [sdp] keys go on top of them here.
 // The log reader's repairs of odometry that ran against the log's own velocity
 // (io::LogReader::next()): worth a line, the map depends on them.
 void report_odometry_repairs(std::size_t repaired) {
@@ -48,6 +46,8 @@ void report_odometry_repairs(std::size_t repaired) {
                repaired);
 }
 
+// `config` holds the profile's bottom-level options with the file's keys on top; `sdp`
+// the profile's top-level options, the file's [sdp] keys go on top of them here.
 int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOptions& sdp, SdpProfile profile) {
   slam::SdpRunOptions ro;
   ro.config = config;

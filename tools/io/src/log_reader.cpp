@@ -180,7 +180,7 @@ struct LogReader::Impl {
   Pose2 dp_odom;
 
   // Reversed-odometry repair (LogReader::next()): the last velocity-carrying pose as
-  // written and as repaired, and its velocity.
+  // written and as repaired.
   bool repair_latched = false;
   bool repair_active = false;  // a repair happened: poses go through the repaired chain
   Pose2 repair_last_raw;
