@@ -375,8 +375,22 @@ TEST(LogReader, self_consistent_odometry_is_returned_as_written) {
   s += odom_tv("0.1 0.65 0.2", "-0.4", "100.1") + "\n";  // backwards, as measured
   s += odom_tv("1.1 0.9 0.3", "0", "100.2") + "\n";     // no velocity measured
   s += flaser_line(3, "1.0", "1.2 0.95 0.3", "100.25") + "\n";
-  const LogContents c = read_all(dir.write("ok.clf", s));
-  CHECK_EQUAL(3U, c.odoms.size());
+  // In-place turns while a small velocity is reported, either sign: the position does
+  // not change, so the forward component is exactly 0 and nothing contradicts it.
+  // These headings are ones where a⁻¹ ⊕ b leaves a residue of ±1e-16 in x.
+  s += odom_tv("1.1 0.9 0.8", "0.01", "100.3") + "\n";
+  s += odom_tv("1.1 0.9 2.9", "-0.01", "100.4") + "\n";
+  s += odom_tv("1.1 0.9 -2.2", "-0.01", "100.5") + "\n";
+  const std::string path = dir.write("ok.clf", s);
+  LogReader reader;
+  std::string error;
+  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  while (reader.next() != LogReader::Next::kEnd) {
+  }
+  CHECK_EQUAL(0U, reader.odometry_reversals_repaired());
+  const LogContents c = read_all(path);
+  CHECK_EQUAL(6U, c.odoms.size());
+  CHECK_EQUAL(-2.2, c.odoms[5].pose.heading_rad);
   CHECK_EQUAL(1U, c.lasers.size());
   CHECK_EQUAL(0.1, c.odoms[1].pose.x_m);
   CHECK_EQUAL(0.65, c.odoms[1].pose.y_m);

@@ -187,8 +187,13 @@ struct LogReader::Impl {
   Pose2 repair_last_pose;
   std::size_t repairs = 0;
 
-  static bool against_velocity(const Pose2& d, double tv_mps) {
-    return (tv_mps < 0.0 && d.x_m > 0.0) || (tv_mps > 0.0 && d.x_m < 0.0);
+  // The increment's forward component, from the raw coordinate differences: exactly 0
+  // when the position did not change (an in-place turn), where between()'s rotation
+  // would leave a rounding residue of either sign.
+  static bool against_velocity(const Pose2& from, const Pose2& to, double tv_mps) {
+    const double forward_m =
+        det::cos(from.heading_rad) * (to.x_m - from.x_m) + det::sin(from.heading_rad) * (to.y_m - from.y_m);
+    return (tv_mps < 0.0 && forward_m > 0.0) || (tv_mps > 0.0 && forward_m < 0.0);
   }
   static Pose2 mirrored(const Pose2& d) { return Pose2{-d.x_m, -d.y_m, d.heading_rad}; }
 
@@ -197,7 +202,7 @@ struct LogReader::Impl {
     Pose2 out = raw;
     if (repair_latched) {
       Pose2 d = between(repair_last_raw, raw);
-      if (against_velocity(d, tv_mps)) {
+      if (against_velocity(repair_last_raw, raw, tv_mps)) {
         d = mirrored(d);
         ++repairs;
         repair_active = true;
