@@ -160,7 +160,7 @@ bool FrameGraph::add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, cons
     return false;
   }
   const double c = robust_chi > 0.0 ? robust_chi : options_.robust_chi;
-  loop_[loops_] = Constraint{i, j, z, info, c * c};
+  loop_[loops_] = Constraint{i, j, z, info, c * c};  // c² = +inf: no kernel (weight 1, cost χ²)
   loop_w_[loops_] = 1.0;
   ++loops_;
   return true;
@@ -294,11 +294,15 @@ void FrameGraph::optimise() {
   double* hp = work_ + 4U * m;
   // work_ + 15·max_nodes .. 18·max_nodes: the preconditioner's y (see precondition()).
   const std::size_t dim = 3U * n_;
-  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy, c per loop).
+  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy, c per
+  // loop; χ² for a loop without a kernel).
   auto total_chi2 = [&]() {
     double s = 0.0;
     for (std::uint32_t k = 1; k < n_; ++k) s += chi2(seq_[k]);
-    for (std::uint32_t q = 0; q < loops_; ++q) s += loop_[q].c2 * det::log(1.0 + chi2(loop_[q]) / loop_[q].c2);
+    for (std::uint32_t q = 0; q < loops_; ++q) {
+      const double x2 = chi2(loop_[q]);
+      s += loop_[q].c2 < kNoKernel ? loop_[q].c2 * det::log(1.0 + x2 / loop_[q].c2) : x2;
+    }
     return s;
   };
   stats_.last_chi2_before = total_chi2();

@@ -97,7 +97,6 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("loop_search_confirm_rad", loop_search_confirm_rad, 0.0, 3.14159265358979323846);
   c.real("loop_search_drift_m", loop_search_drift_m, 0.0, 100.0);
   c.integer("loop_search_candidates", loop_search_candidates, 1U, kMaxLoopSearchCandidates);
-  c.real("loop_search_robust_chi", loop_search_robust_chi, 1.0e-3, 1.0e3);
   c.integer("loop_search_reads_per_scan", loop_search_reads_per_scan, 10000U, 1000000000U);
   if (c.ok && loop_search_confirm_score > loop_search_min_score) {
     c.fail("loop_search_confirm_score: above loop_search_min_score (a held peak must score less than a trusted one)");

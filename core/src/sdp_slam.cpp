@@ -107,11 +107,6 @@ double SdpStats::error_std_m() const {
   return v > 0.0 ? det::sqrt(v) : 0.0;
 }
 
-double SdpSlam::loop_search_chi(double chi_at_10_levels, std::uint32_t older_level, std::uint32_t newer_level) {
-  const std::uint32_t gap = newer_level > older_level ? newer_level - older_level : 1U;
-  return chi_at_10_levels * det::sqrt(static_cast<double>(gap) / 10.0);
-}
-
 double SdpSlam::box_overlap_m2(const double a[4], const double b[4]) {
   const double x0 = a[0] > b[0] ? a[0] : b[0];
   const double y0 = a[1] > b[1] ? a[1] : b[1];
@@ -1269,8 +1264,9 @@ void SdpSlam::adjust_frames() {
     const LoopRecord& r = loops_[k];
     std::uint32_t a = 0U, b = 0U;
     if (!graph_index(r.older_level, &a) || !graph_index(r.newer_level, &b)) continue;
-    const double chi = r.searched ? loop_search_chi(options_.loop_search_robust_chi, r.older_level, r.newer_level)
-                                  : options_.loop_robust_chi;
+    // The search's constraints were verified before they were recorded (loop_search_continue);
+    // the top level's ICP constraints were not, and keep their kernel.
+    const double chi = r.searched ? FrameGraph::kNoKernel : options_.loop_robust_chi;
     if (g.add_loop(a, b, r.z, r.info, chi)) {
       ++used;
     } else {

@@ -499,15 +499,6 @@ TEST(SdpSlam, deferred_top_work_still_runs_when_the_bottom_level_processes_every
   CHECK(rig.slam->stats().evaluations > 0U);
 }
 
-TEST(SdpSlam, searched_loops_get_a_kernel_that_grows_with_the_levels_between) {
-  DOUBLES_EQUAL(30.0, SdpSlam::loop_search_chi(30.0, 5U, 15U), 1e-12);
-  DOUBLES_EQUAL(60.0, SdpSlam::loop_search_chi(30.0, 0U, 40U), 1e-12);
-  DOUBLES_EQUAL(30.0 * std::sqrt(0.2), SdpSlam::loop_search_chi(30.0, 7U, 9U), 1e-12);
-  // Never zero, whatever the order of the levels.
-  DOUBLES_EQUAL(30.0 * std::sqrt(0.1), SdpSlam::loop_search_chi(30.0, 9U, 9U), 1e-12);
-  DOUBLES_EQUAL(30.0 * std::sqrt(0.1), SdpSlam::loop_search_chi(30.0, 9U, 3U), 1e-12);
-}
-
 TEST(SdpSlam, same_seed_gives_bit_identical_trajectories) {
   const test::ScanSet set(2);
   test::SdpRig a;

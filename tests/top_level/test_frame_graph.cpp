@@ -1,6 +1,7 @@
 // FrameGraph (core/frame_graph.h): the loop-closure pose graph over submap frames.
 // A drifting chain around a square loop is pulled back onto the true frames by one loop
-// constraint; a wrong loop constraint among good ones is down-weighted by the kernel;
+// constraint; a wrong loop constraint among good ones is down-weighted by the kernel; a
+// verified loop without a kernel closes a drift of metres;
 // a corridor match pulls across the corridor, not along it; capacities refuse and
 // count; results are bit-identical across runs.
 #include <cmath>
@@ -120,6 +121,47 @@ TEST(FrameGraph, a_loop_with_its_own_wide_kernel_closes_a_drift_of_metres) {
   CHECK_TRUE(narrow > 5.0 * wide);
   CHECK_FALSE(rig->graph.add_loop(0, 15, Pose2{}, info, -1.0));
   CHECK_FALSE(rig->graph.add_loop(0, 15, Pose2{}, info, std::nan("")));
+}
+
+// A verified loop (kNoKernel) enters as plain least squares: full weight however far
+// the chain is off, the least-squares limit of an ever wider kernel, and a finite
+// objective that decreases. With a Cauchy kernel the same constraint is discounted
+// while its residual is large: two loops that both saw a broken chain step (0.45 rad,
+// as a turn in a doorway can give) disagree with the chain by metres.
+TEST(FrameGraph, a_verified_loop_without_a_kernel_is_plain_least_squares) {
+  const FrameInfo info = FrameInfo::from_sigma(0.1, 0.02);
+  // A corridor: 16 frames 3 m apart; the chain's step into frame 4 turned 0.45 rad too far.
+  std::vector<Pose2> t;
+  for (int k = 0; k < 16; ++k) t.push_back(Pose2{3.0 * k, 0.0, 0.0});
+  auto solve = [&](double chi) {
+    rig->graph.clear();
+    Pose2 est = t[0];
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      Pose2 z;
+      if (k > 0) {
+        z = between(t[k - 1], t[k]);
+        if (k == 4) z.heading_rad += 0.45;
+        est = est.compose(z);
+      }
+      CHECK_TRUE(rig->graph.add_node(k == 0 ? t[0] : est, z, info));
+    }
+    CHECK_TRUE(position_error(rig->graph.frame(6), t[6]) > 2.0);
+    CHECK_TRUE(rig->graph.add_loop(2, 6, between(t[2], t[6]), info, chi));
+    CHECK_TRUE(rig->graph.add_loop(3, 7, between(t[3], t[7]), info, chi));
+    rig->graph.optimise();
+  };
+  solve(FrameGraph::kNoKernel);
+  DOUBLES_EQUAL(1.0, rig->graph.loop_weight(0), 0.0);
+  DOUBLES_EQUAL(1.0, rig->graph.loop_weight(1), 0.0);
+  CHECK_TRUE(std::isfinite(rig->graph.stats().last_chi2_before));
+  CHECK_TRUE(rig->graph.stats().last_chi2_after < rig->graph.stats().last_chi2_before);
+  const Pose2 plain = rig->graph.frame(6);
+  CHECK_TRUE(position_error(plain, t[6]) < 0.3);
+  solve(1.0e6);
+  CHECK_TRUE(position_error(rig->graph.frame(6), plain) < 1e-6);
+  solve(19.0);
+  CHECK_TRUE(rig->graph.loop_weight(0) < 1.0);
+  CHECK_FALSE(rig->graph.add_loop(0, 15, Pose2{}, info, -FrameGraph::kNoKernel));
 }
 
 TEST(FrameGraph, capacities_refuse_and_count_and_bad_indices_are_refused) {

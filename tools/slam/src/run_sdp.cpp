@@ -232,7 +232,6 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "loop_search_confirm_rad") ok = real(&t.loop_search_confirm_rad);
   else if (key == "loop_search_drift_m") ok = real(&t.loop_search_drift_m);
   else if (key == "loop_search_candidates") ok = integer(&t.loop_search_candidates);
-  else if (key == "loop_search_robust_chi") ok = real(&t.loop_search_robust_chi);
   else if (key == "loop_search_reads_per_scan") ok = integer(&t.loop_search_reads_per_scan);
   else return SdpKeyResult::kUnknown;
   if (!ok) {

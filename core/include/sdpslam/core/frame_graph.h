@@ -25,6 +25,7 @@
 // (det:: trigonometry, fixed iteration counts and order).
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/pose2.h"
@@ -93,8 +94,11 @@ class FrameGraph {
   // the information is bad.
   bool add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info);
   // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added), behind
-  // a Cauchy kernel of scale robust_chi (0 = the options' scale). False when full or
-  // the indices, the scale or the information (FrameInfo::valid) are bad.
+  // a Cauchy kernel of scale robust_chi (0 = the options' scale; kNoKernel = plain least
+  // squares, for a constraint verified before it was added: a kernel would leave a true
+  // loop of metres only partly closed). False when full or the indices, the scale or
+  // the information (FrameInfo::valid) are bad.
+  static constexpr double kNoKernel = std::numeric_limits<double>::infinity();
   bool add_loop(std::uint32_t i, std::uint32_t j, const Pose2& z, const FrameInfo& info, double robust_chi = 0.0);
   // Gauss-Newton over nodes 1 .. n-1; node 0 stays where it is.
   void optimise();

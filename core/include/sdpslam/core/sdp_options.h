@@ -159,7 +159,10 @@ struct SdpOptions {
   // reaching loop_search_max_ambiguity × it) refined by obstacle ICP with the
   // loop_max_error_m / loop_min_pairs tests becomes a loop constraint. 0 = off.
   double loop_search_window_m = 0.0;           // [0, 20]
-  double loop_search_window_rad = 0.35;        // [0, pi]
+  // ±0.6 rad: a cheap robot's heading is commonly 30° off after a long loop, and a single
+  // bad turn of the bottom level can leave a quarter radian; the search is exact within
+  // its window, so a drift just outside it is a loop lost.
+  double loop_search_window_rad = 0.6;         // [0, pi]
   double loop_search_min_score = 0.45;         // (0, 1]
   double loop_search_max_ambiguity = 0.9;      // (0, 1]
   // A peak scoring at least loop_search_confirm_score but below loop_search_min_score
@@ -187,14 +190,6 @@ struct SdpOptions {
   // was 0.077), ACES 0.065-0.097 m (mean 0.080, unchanged). 0: off.
   double loop_search_drift_m = 2.0;            // [0, 100]
   std::uint32_t loop_search_candidates = 4U;   // 1 .. kMaxLoopSearchCandidates
-  // Cauchy scale on the constraints the search found (loop_robust_chi is for the top
-  // level's), for two submaps 10 levels apart; it grows with the square root of the
-  // levels between them (SdpSlam::loop_search_chi: the chain drifts like a random walk).
-  // After a long loop they must be allowed to pull the chain by metres, far beyond
-  // loop_sigma_xy_m × loop_robust_chi; a false match between nearby submaps must not.
-  // On Intel (seeds 1-5) a constant 30 left two seeds at 0.11-0.12 m and a constant 10
-  // or 20 failed to close ACES's first loop on seed 2.
-  double loop_search_robust_chi = 30.0;        // [1e-3, 1e3]
   // Grid reads of the search per process() call (about 1 ns each): a search is spread
   // over as many calls as it needs, whole headings at a time (at least one per call).
   std::uint32_t loop_search_reads_per_scan = 3000000U;  // [10000, 1e9]

@@ -63,9 +63,10 @@
 // Wide loop search (SdpOptions::loop_search_window_m > 0): ICP only sees loops the chain
 // already closed to within decimetres, so once per level the chosen submap is also
 // searched against the older submaps it may revisit, over metres and tenths of a
-// radian (correlative_matcher.h); an unambiguous peak that obstacle ICP confirms becomes
-// a constraint behind its own kernel, wider the more levels lie between the two
-// submaps (loop_search_chi()), and the frames are adjusted at once. The
+// radian (correlative_matcher.h); an unambiguous peak that obstacle ICP confirms, and
+// that either stays within the chain's drift or is corroborated by a second older
+// submap, is verified: it becomes a constraint without a robust kernel (a kernel would
+// keep a true loop of metres only partly closed) and the frames are adjusted at once. The
 // search runs in slices (loop_search_reads_per_scan grid reads per call of process()).
 //
 // Worst-scan time: anchorage work is spread over calls of process() within
@@ -245,10 +246,6 @@ class SdpSlam {
   // Mean/std of the ICP error over the top-level particles that have one (0 if none).
   void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;
 
-  // Cauchy scale of a loop constraint the wide search found between two levels: the
-  // chain's drift between two submaps grows like a random walk along it, so the scale
-  // grows with the square root of the levels between them (chi_at_10_levels at 10).
-  static double loop_search_chi(double chi_at_10_levels, std::uint32_t older_level, std::uint32_t newer_level);
   // Pure helper: share (m²) of the overlap of two axis-aligned boxes.
   static double box_overlap_m2(const double a[4], const double b[4]);
 
