@@ -189,7 +189,13 @@ struct SdpOptions {
   // loops, 7 m over 15-21 hops). With 2.0, seeds 1-10: Intel 0.059-0.081 m (mean 0.067,
   // was 0.077), ACES 0.065-0.097 m (mean 0.080, unchanged). 0: off.
   double loop_search_drift_m = 2.0;            // [0, 100]
-  std::uint32_t loop_search_candidates = 4U;   // 1 .. kMaxLoopSearchCandidates
+  // Older submaps searched per level, largest overlaps first. A place revisited after a
+  // long loop overlaps many older submaps (a corridor walked several times, rooms along
+  // it), and the one that the drifted chain puts nearest is often not the one the robot
+  // is really in; each candidate is a compute budget (one exact search, spread over
+  // scans by loop_search_reads_per_scan), and each is one more chance for a false peak,
+  // which the verification above has to catch.
+  std::uint32_t loop_search_candidates = 8U;   // 1 .. kMaxLoopSearchCandidates
   // Grid reads of the search per process() call (about 1 ns each): a search is spread
   // over as many calls as it needs, whole headings at a time (at least one per call).
   std::uint32_t loop_search_reads_per_scan = 3000000U;  // [10000, 1e9]
