@@ -14,7 +14,7 @@
 //   e = t2v(Z⁻¹ ⊕ (X_i⁻¹ ⊕ X_j)),  cost ½ eᵀ Ω e,  Ω = diag(1/σ_xy², 1/σ_xy², 1/σ_θ²).
 // Loop constraints pass through a Cauchy kernel (weight 1 / (1 + χ²/c²), χ² = eᵀΩe,
 // recomputed every Gauss-Newton step), so a wrong match that disagrees with the rest
-// pulls little.
+// pulls little; a loop verified before it was added may go without one (kNoKernel).
 //
 // Solver: Gauss-Newton on the poses (additive update of x, y, θ). Each step solves
 // H Δ = -b by preconditioned conjugate gradients; H is never formed, H·v is summed over
