@@ -158,11 +158,18 @@ double BeamModel::likelihood(const DpMap& map, const ScanRays& rays, const Pose2
   const double unknown = options_.unknown_stop_probability;
   double prod = 1.0;
   std::int64_t exponent = 0;
+  // On a torus map (DpMap::Options::wrap) a lookup is exact closer than half a window to
+  // the square that holds the lineage's updates, so within half a window of the robot
+  // (which is in that square). A longer reading would be judged against cells a window
+  // away: it is left out, like a beam without return.
+  const std::int32_t side = map.width_cells() < map.height_cells() ? map.width_cells() : map.height_cells();
+  const double reach_m = map.wraps() ? 0.5 * res * static_cast<double>(side) : 1.0e300;
   for (std::uint32_t b = 0; b < rays.count; b += stride) {
     if (rays.kind[b] != static_cast<std::uint8_t>(RangeScan::Beam::kReturn)) continue;
+    const double r = static_cast<double>(rays.range_m[b]);
+    if (r + w > reach_m) continue;
     ++beams;
     bool known = false;
-    const double r = static_cast<double>(rays.range_m[b]);
     const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
     const double dy = lf.s * rays.cos_a[b] + lf.c * rays.sin_a[b];
     const double d0 = r > w ? r - w : 0.0;

@@ -7,6 +7,10 @@ namespace sdpslam {
 
 namespace {
 
+// Largest torus side (cells): far below 2^31, so that coordinates a window apart stay in
+// int32 wherever a lineage may draw.
+constexpr std::int64_t kMaxWrapCells = std::int64_t{1} << 20;
+
 struct GridDims {
   std::int32_t width_cells = 0;
   std::int32_t height_cells = 0;
@@ -30,6 +34,17 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   d->width_cells = cells_for(o.width_m, o.resolution_m);
   d->height_cells = cells_for(o.height_m, o.resolution_m);
   if (d->width_cells <= 0 || d->height_cells <= 0) return false;
+  if (o.wrap) {
+    // A torus: whole tiles per axis, a power of two of them, so that a cell's place is
+    // its coordinates' low bits (also for negative ones, in two's complement).
+    std::int64_t w = capacity::kDpTileSideCells;
+    std::int64_t h = capacity::kDpTileSideCells;
+    while (w < d->width_cells) w <<= 1;
+    while (h < d->height_cells) h <<= 1;
+    if (w > kMaxWrapCells || h > kMaxWrapCells) return false;
+    d->width_cells = static_cast<std::int32_t>(w);
+    d->height_cells = static_cast<std::int32_t>(h);
+  }
   const std::uint32_t side = capacity::kDpTileSideCells;
   d->tiles_x = (static_cast<std::uint32_t>(d->width_cells) + side - 1U) / side;
   d->tiles_y = (static_cast<std::uint32_t>(d->height_cells) + side - 1U) / side;
@@ -115,6 +130,9 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   height_cells_ = d.height_cells;
   tiles_x_ = d.tiles_x;
   tiles_y_ = d.tiles_y;
+  wrap_ = options.wrap;
+  tile_mask_x_ = wrap_ ? tiles_x_ - 1U : 0xFFFFFFFFU;
+  tile_mask_y_ = wrap_ ? tiles_y_ - 1U : 0xFFFFFFFFU;
   node_capacity_ = tree.capacity();
   tiles_ = nullptr;
   obs_ = nullptr;
@@ -126,6 +144,14 @@ bool DpMap::world_to_cell(double x_m, double y_m, std::int32_t* ix, std::int32_t
   if (tree_ == nullptr) return false;
   const double fx = std::floor((x_m - options_.origin_x_m) / options_.resolution_m);
   const double fy = std::floor((y_m - options_.origin_y_m) / options_.resolution_m);
+  if (wrap_) {
+    // Any place has a cell; the bound only keeps the coordinates in int32 (and rejects NaN).
+    constexpr double kLimit = 1073741824.0;  // 2^30 cells
+    if (!(fx > -kLimit && fx < kLimit && fy > -kLimit && fy < kLimit)) return false;
+    *ix = static_cast<std::int32_t>(fx);
+    *iy = static_cast<std::int32_t>(fy);
+    return true;
+  }
   // The negated comparisons also reject NaN.
   if (!(fx >= 0.0 && fx < static_cast<double>(width_cells_) && fy >= 0.0 && fy < static_cast<double>(height_cells_))) {
     return false;
@@ -473,7 +499,9 @@ std::uint32_t DpMap::fill_rect(NodeId particle, const CellRect& rect, CellObserv
     for (std::uint32_t col = 0U; col < rect.width; ++col, ++i) {
       const std::int64_t ix64 = static_cast<std::int64_t>(rect.ix0) + col;
       bool ok = false;
-      if (tree_ != nullptr && ix64 >= 0 && iy64 >= 0 && ix64 < width_cells_ && iy64 < height_cells_) {
+      const bool inside = wrap_ ? (ix64 > INT32_MIN && ix64 < INT32_MAX && iy64 > INT32_MIN && iy64 < INT32_MAX)
+                                : (ix64 >= 0 && iy64 >= 0 && ix64 < width_cells_ && iy64 < height_cells_);
+      if (tree_ != nullptr && inside) {
         ok = lookup(particle, static_cast<std::int32_t>(ix64), static_cast<std::int32_t>(iy64), &values[i]);
       }
       known[i] = ok ? 1U : 0U;
@@ -481,6 +509,19 @@ std::uint32_t DpMap::fill_rect(NodeId particle, const CellRect& rect, CellObserv
     }
   }
   return known_count;
+}
+
+void DpMap::unwrap_near(std::int32_t* ix, std::int32_t* iy, std::int32_t near_ix, std::int32_t near_iy) const {
+  if (!wrap_) return;
+  // The representative of ix modulo the width that lies in [near - width/2, near + width/2).
+  const auto nearest = [](std::int32_t v, std::int32_t near, std::int32_t side) {
+    const std::int64_t half = side / 2;
+    const std::int64_t d = static_cast<std::int64_t>(v) - near + half;
+    const std::int64_t m = ((d % side) + side) % side;
+    return static_cast<std::int32_t>(static_cast<std::int64_t>(near) - half + m);
+  };
+  *ix = nearest(*ix, near_ix, width_cells_);
+  *iy = nearest(*iy, near_iy, height_cells_);
 }
 
 bool DpMap::touched_bounds(CellRect* out) const {

@@ -32,6 +32,14 @@ DpMap::Options map_options(const DpSlamOptions& o) {
   m.tile_capacity = o.tile_capacity();
   m.observation_capacity = o.observation_capacity();
   m.owner_cell_index = o.map_owner_cell_index;
+  m.wrap = o.map_wrap;
+  if (m.wrap) {
+    // The origin stays where the area puts it (the same cells as without wrap); the
+    // window is at least 8 × the reach of a map update (DpSlamOptions::map_wrap).
+    const double window_m = 8.0 * (o.beam.max_update_range_m + 2.0 * o.map_resolution_m) + o.map_resolution_m;
+    if (m.width_m < window_m) m.width_m = window_m;
+    if (m.height_m < window_m) m.height_m = window_m;
+  }
   return m;
 }
 

@@ -1,5 +1,6 @@
 #include "sdpslam/core/sdp_slam.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <new>
@@ -132,6 +133,9 @@ DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const Sdp
   // Few particles per segment: the DP map's (owner, cell) index would cost a third of the
   // memory budget for little time (the index is for DP-SLAM at hundreds of particles).
   b.map_owner_cell_index = sdp.map_owner_cell_index;
+  // The DP map is a torus that moves with the robot (sdp_slam.h): each segment is a
+  // lineage of its own, kept within a square of half the window by segmenting.
+  b.map_wrap = true;
   return b;
 }
 
@@ -147,9 +151,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   const std::size_t L = s.max_levels;
   const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
   const std::size_t cs = coarse_side_cells(b, s);
-  const std::size_t pb = PermanentMap::required_bytes(DpMap::cells_along(b.map_width_m, b.map_resolution_m),
-                                                      DpMap::cells_along(b.map_height_m, b.map_resolution_m),
-                                                      s.permanent_map_tiles);
+  const std::size_t pb = PermanentMap::required_bytes(s.permanent_map_tiles);
   if (pb == 0U) return 0U;
   std::size_t total = fb + gb + pb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
   total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
@@ -178,12 +180,6 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   if (!s.validate(why_, sizeof why_)) return false;
   const DpSlamOptions b = bottom_options_for(bottom_in, s);
   if (!b.validate(why_, sizeof why_)) return false;
-  const std::int32_t map_w = DpMap::cells_along(b.map_width_m, b.map_resolution_m);
-  const std::int32_t map_h = DpMap::cells_along(b.map_height_m, b.map_resolution_m);
-  if (PermanentMap::required_bytes(map_w, map_h, s.permanent_map_tiles) == 0U) {
-    std::snprintf(why_, sizeof why_, "permanent map: the %d x %d cell map area is out of range", map_w, map_h);
-    return false;
-  }
   const std::size_t need = required_arena_bytes(bottom_in, s);
   if (need == 0U || arena.available_bytes() < need) {
     std::snprintf(why_, sizeof why_, "arena too small: %zu bytes available, %zu needed", arena.available_bytes(), need);
@@ -216,7 +212,23 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     return false;
   }
   filter_->set_pose_sink(&ring_sink_);
-  if (!permanent_map_.init(arena, filter_->map().width_cells(), filter_->map().height_cells(), s.permanent_map_tiles)) {
+  {
+    // A segment's updates must stay within a square of half the window (DpMap's wrap
+    // contract): its path within window/8 of its start (segmentation, process()) and its
+    // beams' updates within max_update_range_m of the path, so that range (plus a cell
+    // for the rounding) must fit in window/8.
+    const DpMap& map = filter_->map();
+    const std::int32_t side = map.width_cells() < map.height_cells() ? map.width_cells() : map.height_cells();
+    window_radius_m_ = 0.125 * map.resolution_m() * static_cast<double>(side);
+    if (b.beam.max_update_range_m + 2.0 * map.resolution_m() > window_radius_m_) {
+      std::snprintf(why_, sizeof why_,
+                    "observation.max_update_range_m %.3g m needs a map window of at least %.3g m "
+                    "(map.width_m and map.height_m)",
+                    b.beam.max_update_range_m, 8.0 * (b.beam.max_update_range_m + 2.0 * map.resolution_m()));
+      return false;
+    }
+  }
+  if (!permanent_map_.init(arena, s.permanent_map_tiles)) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving the permanent map");
     return false;
   }
@@ -334,10 +346,23 @@ CellRect SdpSlam::rect_around(double x0, double y0, double x1, double y1, double
   std::int32_t iy0 = cell(y0 - pad_m, oy);
   std::int32_t ix1 = cell(x1 + pad_m, ox) + 1;
   std::int32_t iy1 = cell(y1 + pad_m, oy) + 1;
-  if (ix0 < 0) ix0 = 0;
-  if (iy0 < 0) iy0 = 0;
-  if (ix1 > map.width_cells()) ix1 = map.width_cells();
-  if (iy1 > map.height_cells()) iy1 = map.height_cells();
+  if (map.wraps()) {
+    // No edge; a segment's map lies within half the window (process()), and reading
+    // more would meet the other copies of its cells: a centred crop.
+    const auto crop = [](std::int32_t* lo, std::int32_t* hi, std::int32_t side) {
+      const std::int64_t extra = static_cast<std::int64_t>(*hi) - *lo - side / 2;
+      if (extra <= 0) return;
+      *lo = static_cast<std::int32_t>(*lo + extra / 2);
+      *hi = *lo + side / 2;
+    };
+    crop(&ix0, &ix1, map.width_cells());
+    crop(&iy0, &iy1, map.height_cells());
+  } else {
+    if (ix0 < 0) ix0 = 0;
+    if (iy0 < 0) iy0 = 0;
+    if (ix1 > map.width_cells()) ix1 = map.width_cells();
+    if (iy1 > map.height_cells()) iy1 = map.height_cells();
+  }
   if (ix1 <= ix0 || iy1 <= iy0) return r;
   r.ix0 = ix0;
   r.iy0 = iy0;
@@ -382,12 +407,19 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
     box_add(seg_box_, best.x_m, best.y_m);
     const std::uint32_t n = filter_->particle_count();
     for (std::uint32_t i = 0; i < n; ++i) poses_scratch_[i] = filter_->particle_pose(i);
-    const SegmentEnd end = segmenter_->on_processed(scan.stamp_us, odom.pose, poses_scratch_, n);
+    SegmentEnd end = segmenter_->on_processed(scan.stamp_us, odom.pose, poses_scratch_, n);
+    if (end == SegmentEnd::kNone) {
+      // The segment's lineage must stay within its square of the DP map's torus.
+      const double dx = best.x_m - segment_start_pose_.x_m;
+      const double dy = best.y_m - segment_start_pose_.y_m;
+      if (!(dx * dx + dy * dy <= window_radius_m_ * window_radius_m_)) end = SegmentEnd::kWindow;
+    }
     if (end != SegmentEnd::kNone) {
       const std::uint64_t before = stats_.segments;
       segment(scan.stamp_us);
       if (stats_.segments != before) {
         result.segmented = end;
+        if (end == SegmentEnd::kWindow) ++stats_.window_segmentations;
         segmenter_->start(scan.stamp_us, odom.pose);
       }
     }
@@ -577,8 +609,9 @@ void SdpSlam::make_oldest_permanent() {
 }
 
 // One cell of the permanent submap into the permanent map, at its place in the global
-// frame, tagged with its level; counted, and counted as dropped when outside the map or
-// refused (every tile taken).
+// frame (the DP map's cell frame: same origin and resolution, no edge), tagged with its
+// level; counted, and counted as dropped when refused (every tile taken) or too far out
+// for int32 cells.
 void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v) {
   const DpMap& map = filter_->map();
   double cx = 0.0;
@@ -587,10 +620,13 @@ void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservat
   double gx = 0.0;
   double gy = 0.0;
   transfer_.frame.transform_point(cx, cy, gx, gy);
-  std::int32_t gix = 0;
-  std::int32_t giy = 0;
   ++stats_.map_transfer_cells;
-  if (!map.world_to_cell(gx, gy, &gix, &giy) || !permanent_map_.add(gix, giy, v.hits, v.misses, transfer_.tag)) {
+  const double fx = std::floor((gx - map.options().origin_x_m) / map.resolution_m());
+  const double fy = std::floor((gy - map.options().origin_y_m) / map.resolution_m());
+  constexpr double kLimit = 1073741824.0;  // 2^30 cells
+  if (!(fx > -kLimit && fx < kLimit && fy > -kLimit && fy < kLimit) ||
+      !permanent_map_.add(static_cast<std::int32_t>(fx), static_cast<std::int32_t>(fy), v.hits, v.misses,
+                          transfer_.tag)) {
     ++stats_.map_transfer_dropped;
   }
 }
@@ -614,8 +650,12 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
     std::int32_t iy = 0;
     CellObservation v{};
     bool more = true;
+    // Popped cells come in window coordinates; the submap's are those near its rectangle.
+    const std::int32_t mid_x = r.ix0 + static_cast<std::int32_t>(r.width / 2U);
+    const std::int32_t mid_y = r.iy0 + static_cast<std::int32_t>(r.height / 2U);
     while (used < budget_cells && (more = filter_->pop_anchored_observation(transfer_.node, &ix, &iy, &v))) {
       used += kPopCostCells;
+      map.unwrap_near(&ix, &iy, mid_x, mid_y);
       transfer_cell(ix, iy, v);
     }
     if (!more) transfer_.next_row = r.height;

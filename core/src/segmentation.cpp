@@ -10,6 +10,7 @@ const char* to_string(SegmentEnd reason) {
     case SegmentEnd::kPeriod: return "period";
     case SegmentEnd::kDispersion: return "dispersion";
     case SegmentEnd::kMaxLength: return "max_length";
+    case SegmentEnd::kWindow: return "window";
   }
   return "?";
 }

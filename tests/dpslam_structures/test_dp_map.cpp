@@ -7,9 +7,13 @@
 #include <limits>
 #include <vector>
 
+#include <map>
+#include <utility>
+
 #include "dp_fixture.h"
 #include "sdpslam/core/dp_map.h"
 #include "sdpslam/core/view_cache.h"
+#include "test_rng.h"
 
 using sdpslam::CellObservation;
 using sdpslam::DpMap;
@@ -489,4 +493,166 @@ TEST(DpMap, view_cache_answers_exactly_what_the_map_answers) {
   // 3 bursts x 2 passes x 24 reads; each burst caches 12 cells, answered in its second pass.
   LONGS_EQUAL(3 * 2 * 24, cache.hits() + cache.misses());
   LONGS_EQUAL(3 * 12, cache.hits());
+}
+
+// ---- torus (Options::wrap) ---------------------------------------------------------
+
+namespace {
+// 2.4 m × 2.0 m asked for: 48 × 40 cells, rounded up to 4 × 4 tiles of 16 = 64 × 64.
+DpMap::Options torus_options(std::uint32_t tiles, std::uint32_t observations) {
+  DpMap::Options o = small_options(tiles, observations);
+  o.wrap = true;
+  return o;
+}
+}  // namespace
+
+TEST(DpMap, a_torus_rounds_each_axis_up_to_a_power_of_two_of_tiles_and_has_no_outside) {
+  DpFixture f(8U, 8U, torus_options(8U, 64U));
+  CHECK_TRUE(f.map.wraps());
+  LONGS_EQUAL(64, f.map.width_cells());
+  LONGS_EQUAL(64, f.map.height_cells());
+  std::int32_t ix = 0;
+  std::int32_t iy = 0;
+  // Far outside the asked area, and negative: still a cell, by floor.
+  CHECK_TRUE(f.map.world_to_cell(-1.0 - 1000.02, 2.0 + 5000.0, &ix, &iy));
+  LONGS_EQUAL(-20001, ix);
+  LONGS_EQUAL(100000, iy);
+  CHECK_FALSE(f.map.world_to_cell(std::numeric_limits<double>::quiet_NaN(), 0.0, &ix, &iy));
+  CHECK_FALSE(f.map.world_to_cell(1.0e12, 0.0, &ix, &iy));  // beyond 2^30 cells
+  const NodeId r = f.tree.create_root();
+  CHECK_TRUE(f.map.update(r, -20001, 100000, obs(3, 1)));
+  CHECK_TRUE(view_is(f.map, r, -20001, 100000, obs(3, 1)));
+  LONGS_EQUAL(0U, f.map.out_of_bounds_count());
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
+TEST(DpMap, on_a_torus_cells_a_window_apart_share_storage_but_lineages_keep_their_views) {
+  DpFixture f(8U, 8U, torus_options(8U, 64U));
+  const NodeId a = f.tree.create_root();  // one segment's lineage ...
+  const NodeId b = f.tree.create_root();  // ... and another's, a window (64 cells) away
+  CHECK_TRUE(f.map.update(a, 5, 7, obs(1, 0)));
+  CHECK_TRUE(f.map.update(b, 5 + 64, 7 - 128, obs(0, 2)));
+  // Same storage cell, two entries; each lineage sees only its own.
+  LONGS_EQUAL(2U, f.map.entries_in_cell(5, 7));
+  CHECK_TRUE(view_is(f.map, a, 5, 7, obs(1, 0)));
+  CHECK_TRUE(view_is(f.map, b, 5 + 64, 7 - 128, obs(0, 2)));
+  // The copies of a cell are one cell for its own lineage: the caller keeps a lineage
+  // within half a window so that it never asks for two of them.
+  CHECK_TRUE(view_is(f.map, a, 5 - 64, 7 + 64, obs(1, 0)));
+  CellObservation v;
+  CHECK_FALSE(f.map.lookup(a, 6, 7, &v));
+  CHECK_TRUE(f.map.invariants_hold());
+}
+
+TEST(DpMap, popped_cells_of_a_torus_come_back_next_to_their_place_with_unwrap_near) {
+  DpFixture f(8U, 8U, torus_options(8U, 64U));
+  const NodeId r = f.tree.create_root();
+  // A lineage drawn far from the origin, within half a window (32 cells) of (-1000, 3000).
+  const std::int32_t cells[][2] = {{-1000, 3000}, {-1015, 2990}, {-985, 3014}, {-1001, 2999}};
+  for (const auto& c : cells) CHECK_TRUE(f.map.update(r, c[0], c[1], obs(1, 1)));
+  std::int32_t ix = 0;
+  std::int32_t iy = 0;
+  CellObservation v;
+  std::uint32_t found = 0U;
+  while (f.map.pop_observation(r, &ix, &iy, &v)) {
+    CHECK(ix >= 0 && ix < 64 && iy >= 0 && iy < 64);  // window coordinates
+    f.map.unwrap_near(&ix, &iy, -1000, 3000);
+    bool match = false;
+    for (const auto& c : cells) match = match || (c[0] == ix && c[1] == iy);
+    CHECK_TRUE(match);
+    ++found;
+  }
+  LONGS_EQUAL(4U, found);
+  // Without wrap, unwrap_near changes nothing.
+  DpFixture g(8U, 8U, small_options(8U, 64U));
+  ix = 70;
+  iy = -3;
+  g.map.unwrap_near(&ix, &iy, 0, 0);
+  LONGS_EQUAL(70, ix);
+  LONGS_EQUAL(-3, iy);
+}
+
+TEST(DpMap, fill_rect_on_a_torus_reads_any_rectangle_in_place) {
+  DpFixture f(8U, 8U, torus_options(8U, 64U));
+  const NodeId r = f.tree.create_root();
+  CHECK_TRUE(f.map.update(r, -3, -2, obs(2, 0)));
+  CHECK_TRUE(f.map.update(r, -1, -1, obs(0, 2)));
+  const sdpslam::CellRect rect{-4, -3, 4, 3};
+  std::vector<CellObservation> values(12U);
+  std::vector<std::uint8_t> known(12U);
+  LONGS_EQUAL(2U, f.map.fill_rect(r, rect, values.data(), known.data()));
+  CHECK_EQUAL(1U, known[1U * 4U + 1U]);  // (-3, -2)
+  CHECK_TRUE(values[1U * 4U + 1U] == obs(2, 0));
+  CHECK_EQUAL(1U, known[2U * 4U + 3U]);  // (-1, -1)
+  CHECK_TRUE(values[2U * 4U + 3U] == obs(0, 2));
+}
+
+// The wrap contract, randomised: lineages (a root and a child that shadows some of its
+// cells) drawn at random places up to ten windows apart, each writing only within its own
+// square of half the window; every lookup closer than half a window to that square gives
+// exactly what a private map of the lineage holds, however the lineages share storage.
+TEST(DpMap, on_a_torus_lookups_near_a_lineages_square_are_exact_wherever_the_lineages_are) {
+  constexpr std::int32_t kWindow = 64;  // torus_options(): 64 × 64 cells
+  constexpr std::int32_t kHalf = kWindow / 2;
+  constexpr std::uint32_t kLineages = 12U;
+  DpFixture f(2U * kLineages, 8U, torus_options(64U, 4096U));
+  LONGS_EQUAL(kWindow, f.map.width_cells());
+  sdpslam::test::SplitMix64 rng{0x7A11ULL};
+  const auto coord = [&rng](std::int32_t lo, std::int32_t span) {
+    return lo + static_cast<std::int32_t>(rng.below(static_cast<std::uint32_t>(span)));
+  };
+  struct Lineage {
+    NodeId root = kNoNode;
+    NodeId leaf = kNoNode;
+    std::int32_t x0 = 0;
+    std::int32_t y0 = 0;  // lower corner of its square of kHalf × kHalf cells
+    std::map<std::pair<std::int32_t, std::int32_t>, CellObservation> cells;  // what its leaf sees
+  };
+  std::vector<Lineage> lineages;
+  for (std::uint32_t k = 0; k < kLineages; ++k) {
+    Lineage l;
+    l.root = f.tree.create_root();
+    l.x0 = coord(-5 * kWindow, 10 * kWindow);
+    l.y0 = coord(-5 * kWindow, 10 * kWindow);
+    lineages.push_back(l);
+  }
+  for (Lineage& l : lineages) {  // every root writes, then every child: interleaved lineages
+    for (int i = 0; i < 150; ++i) {
+      const std::int32_t x = coord(l.x0, kHalf);
+      const std::int32_t y = coord(l.y0, kHalf);
+      const CellObservation v = obs(static_cast<std::uint16_t>(rng.below(50U)), static_cast<std::uint16_t>(rng.below(50U)));
+      CHECK_TRUE(f.map.update(l.root, x, y, v));
+      l.cells[{x, y}] = v;
+    }
+  }
+  for (Lineage& l : lineages) {
+    l.leaf = f.tree.add_child(l.root);
+    for (int i = 0; i < 60; ++i) {
+      const std::int32_t x = coord(l.x0, kHalf);
+      const std::int32_t y = coord(l.y0, kHalf);
+      const CellObservation v = obs(100U, static_cast<std::uint16_t>(rng.below(50U)));
+      CHECK_TRUE(f.map.update(l.leaf, x, y, v));
+      l.cells[{x, y}] = v;
+    }
+  }
+  CHECK_TRUE(f.map.invariants_hold());
+  std::uint32_t known = 0U;
+  for (const Lineage& l : lineages) {
+    // Every cell closer than half a window to the square: (x0 - kHalf, x0 + kHalf + kHalf).
+    for (std::int32_t y = l.y0 - kHalf + 1; y < l.y0 + 2 * kHalf; ++y) {
+      for (std::int32_t x = l.x0 - kHalf + 1; x < l.x0 + 2 * kHalf; ++x) {
+        CellObservation v;
+        const bool seen = f.map.lookup(l.leaf, x, y, &v);
+        const auto it = l.cells.find({x, y});
+        CHECK_EQUAL(it != l.cells.end(), seen);
+        if (seen) {
+          CHECK_TRUE(v == it->second);
+          ++known;
+        }
+      }
+    }
+  }
+  std::uint32_t written = 0U;
+  for (const Lineage& l : lineages) written += static_cast<std::uint32_t>(l.cells.size());
+  LONGS_EQUAL(written, known);
 }

@@ -1,5 +1,6 @@
-// The global map's permanent part (permanent_map.h): tagged cells in fixed tiles, the
-// merge rule, exhaustion and out-of-area writes counted, deterministic iteration.
+// The global map's permanent part (permanent_map.h): tagged cells in fixed tiles over an
+// unbounded area, the merge rule, exhaustion and untagged writes counted, deterministic
+// iteration.
 #include <CppUTest/TestHarness.h>
 
 #include <cstdint>
@@ -17,10 +18,10 @@ struct Rig {
   std::vector<unsigned char> buffer;
   Arena arena;
   PermanentMap map;
-  bool init(std::int32_t w, std::int32_t h, std::uint32_t tiles) {
-    buffer.assign(PermanentMap::required_bytes(w, h, tiles), 0U);
+  bool init(std::uint32_t tiles) {
+    buffer.assign(PermanentMap::required_bytes(tiles), 0U);
     arena.reset(buffer.data(), buffer.size());
-    return map.init(arena, w, h, tiles);
+    return map.init(arena, tiles);
   }
 };
 
@@ -29,28 +30,25 @@ struct Rig {
 TEST_GROUP(PermanentMap){};
 
 TEST(PermanentMap, sizes_out_of_range_need_nothing_and_init_refuses_them) {
-  LONGS_EQUAL(0, PermanentMap::required_bytes(0, 10, 4U));
-  LONGS_EQUAL(0, PermanentMap::required_bytes(10, -1, 4U));
-  LONGS_EQUAL(0, PermanentMap::required_bytes(10, 10, 0U));
-  LONGS_EQUAL(0, PermanentMap::required_bytes((1 << 20) + 1, 10, 4U));
-  // More tiles than the area holds are not provisioned.
-  CHECK_EQUAL(PermanentMap::required_bytes(40, 40, 9U), PermanentMap::required_bytes(40, 40, 1000U));
+  LONGS_EQUAL(0, PermanentMap::required_bytes(0U));
+  LONGS_EQUAL(0, PermanentMap::required_bytes(sdpslam::capacity::kDpMaxTiles + 1U));
+  CHECK(PermanentMap::required_bytes(9U) < PermanentMap::required_bytes(1000U));
   Rig r;
-  CHECK_TRUE(r.init(40, 40, 1000U));
-  LONGS_EQUAL(9, r.map.tile_capacity());  // 3 × 3 tiles of 16 × 16 cover 40 × 40
+  CHECK_TRUE(r.init(1000U));
+  LONGS_EQUAL(1000, r.map.tile_capacity());
   // Too small an arena: refused, and every write refused afterwards.
   std::vector<unsigned char> small(64U);
   Arena a;
   a.reset(small.data(), small.size());
   PermanentMap m;
-  CHECK_FALSE(m.init(a, 40, 40, 4U));
+  CHECK_FALSE(m.init(a, 4U));
   CHECK_FALSE(m.initialised());
   CHECK_FALSE(m.add(1, 1, 1U, 0U, 1U));
 }
 
 TEST(PermanentMap, cells_keep_their_counts_and_the_tag_of_the_larger_contribution) {
   Rig r;
-  CHECK_TRUE(r.init(64, 64, 16U));
+  CHECK_TRUE(r.init(16U));
   LONGS_EQUAL(0, r.map.cell(3, 4).tag);
   CHECK_TRUE(r.map.add(3, 4, 2U, 1U, 7U));
   PermanentMap::Cell c = r.map.cell(3, 4);
@@ -77,13 +75,11 @@ TEST(PermanentMap, cells_keep_their_counts_and_the_tag_of_the_larger_contributio
   LONGS_EQUAL(1, r.map.tiles_used());
 }
 
-TEST(PermanentMap, writes_outside_the_area_untagged_or_past_the_last_tile_are_refused_and_counted) {
+TEST(PermanentMap, untagged_writes_and_writes_past_the_last_tile_are_refused_and_counted) {
   Rig r;
-  CHECK_TRUE(r.init(64, 64, 2U));
-  CHECK_FALSE(r.map.add(-1, 0, 1U, 0U, 1U));
-  CHECK_FALSE(r.map.add(0, 64, 1U, 0U, 1U));
+  CHECK_TRUE(r.init(2U));
   CHECK_FALSE(r.map.add(0, 0, 1U, 0U, 0U));  // tag 0 means "no data"
-  LONGS_EQUAL(3, r.map.refused_out_of_area());
+  LONGS_EQUAL(1, r.map.refused_untagged());
   CHECK_TRUE(r.map.add(0, 0, 1U, 0U, 1U));    // tile (0, 0)
   CHECK_TRUE(r.map.add(20, 0, 1U, 0U, 1U));   // tile (1, 0)
   CHECK_FALSE(r.map.add(40, 40, 1U, 0U, 1U));  // a third tile: none left
@@ -94,24 +90,42 @@ TEST(PermanentMap, writes_outside_the_area_untagged_or_past_the_last_tile_are_re
   LONGS_EQUAL(0, r.map.cell(40, 40).tag);  // the refused write left nothing behind
 }
 
+TEST(PermanentMap, cells_anywhere_in_int32_are_kept_apart_each_in_its_own_tile) {
+  Rig r;
+  CHECK_TRUE(r.init(8U));
+  // Far from the origin, negative, and at the extremes of int32: no area bound.
+  const std::int32_t cells[][2] = {{-1, -1}, {0, 0}, {-17, 5}, {1000000, -2000000}, {2147483647, -2147483647 - 1},
+                                   {-2147483647 - 1, 2147483647}};
+  std::uint32_t tag = 1U;
+  for (const auto& c : cells) CHECK_TRUE(r.map.add(c[0], c[1], 1U, 0U, tag++));
+  LONGS_EQUAL(6, r.map.tiles_used());
+  tag = 1U;
+  for (const auto& c : cells) LONGS_EQUAL(tag++, r.map.cell(c[0], c[1]).tag);
+  // A neighbour in another tile, and the same cell a tile-table width away, stay unknown.
+  LONGS_EQUAL(0, r.map.cell(-1, 0).tag);
+  LONGS_EQUAL(0, r.map.cell(-1 + (1 << 20), -1).tag);
+  LONGS_EQUAL(6, r.map.known_cells());
+}
+
 TEST(PermanentMap, every_known_cell_is_visited_once_in_tile_order) {
   Rig r;
-  CHECK_TRUE(r.init(50, 50, 20U));
+  CHECK_TRUE(r.init(20U));
   // Written in an order unlike the visit order.
-  const std::int32_t cells[][2] = {{49, 49}, {0, 0}, {17, 3}, {3, 17}, {16, 16}, {15, 0}};
-  for (const auto& c : cells) CHECK_TRUE(r.map.add(c[0], c[1], 1U, 1U, static_cast<std::uint32_t>(c[0] + 1)));
+  const std::int32_t cells[][2] = {{49, 49}, {0, 0}, {17, 3}, {3, 17}, {16, 16}, {15, 0}, {-3, -20}};
+  for (const auto& c : cells) CHECK_TRUE(r.map.add(c[0], c[1], 1U, 1U, static_cast<std::uint32_t>(c[0] + 100)));
   std::vector<std::int32_t> xs;
   std::vector<std::int32_t> ys;
   r.map.for_each_cell([&](std::int32_t ix, std::int32_t iy, const PermanentMap::Cell& c) {
     xs.push_back(ix);
     ys.push_back(iy);
-    LONGS_EQUAL(ix + 1, c.tag);
+    LONGS_EQUAL(ix + 100, c.tag);
   });
-  // Tile (0,0): (0,0) then (15,0); tile (1,0): (17,3); tile (0,1): (3,17); tile (1,1): (16,16); tile (3,3): (49,49).
-  const std::int32_t ex[] = {0, 15, 17, 3, 16, 49};
-  const std::int32_t ey[] = {0, 0, 3, 17, 16, 49};
-  LONGS_EQUAL(6, xs.size());
-  for (std::size_t i = 0; i < 6U; ++i) {
+  // Tile (-1,-2): (-3,-20); tile (0,0): (0,0) then (15,0); tile (1,0): (17,3); tile (0,1):
+  // (3,17); tile (1,1): (16,16); tile (3,3): (49,49).
+  const std::int32_t ex[] = {-3, 0, 15, 17, 3, 16, 49};
+  const std::int32_t ey[] = {-20, 0, 0, 3, 17, 16, 49};
+  LONGS_EQUAL(7, xs.size());
+  for (std::size_t i = 0; i < 7U; ++i) {
     LONGS_EQUAL(ex[i], xs[i]);
     LONGS_EQUAL(ey[i], ys[i]);
   }

@@ -597,3 +597,128 @@ TEST(SdpSlam, the_best_map_is_made_of_the_permanent_map_live_submaps_and_the_cur
   });
   LONGS_EQUAL(0, pm.refused_no_tile());
 }
+
+namespace {
+
+// A corridor 3 m wide and 106 m long with pilasters at irregular spacing on both walls,
+// and a robot driving 95 m straight along it with odometry that over-reads by 2 % and
+// drifts sideways (sim_world.h's error model).
+struct Corridor {
+  std::vector<test::Segment> world;
+  test::SimRun run;
+  std::vector<std::unique_ptr<RangeScan>> scans;
+  explicit Corridor(double max_range_m) {
+    const double half_m = 1.5;
+    world.push_back({-3.0, -half_m, -3.0, half_m});
+    world.push_back({103.0, -half_m, 103.0, half_m});
+    for (int side = -1; side <= 1; side += 2) {
+      const double y = side * half_m;
+      const double in = -side * 0.3;  // pilasters stand 0.3 m into the corridor
+      double x = -3.0;
+      double gap = 2.3 + (side > 0 ? 0.9 : 0.0);
+      while (x + gap + 0.4 < 103.0) {
+        const double p = x + gap;
+        world.push_back({x, y, p, y});
+        world.push_back({p, y, p, y + in});
+        world.push_back({p, y + in, p + 0.4, y + in});
+        world.push_back({p + 0.4, y + in, p + 0.4, y});
+        x = p + 0.4;
+        gap = 1.7 + std::fmod(gap * 3.7, 2.9);  // irregular: no period to slide along
+      }
+      world.push_back({x, y, 103.0, y});
+    }
+    Pose2 p{0.0, 0.0, 0.0};
+    run.truth.push_back(p);
+    while (p.x_m < 95.0) {
+      p.x_m += 0.1;
+      run.truth.push_back(p);
+    }
+    Rng rng(5U);
+    Pose2 o = run.truth[0];
+    run.odom.push_back(o);
+    for (std::size_t i = 1; i < run.truth.size(); ++i) {
+      Pose2 d = between(run.truth[i - 1], run.truth[i]);
+      d.heading_rad += rng.gaussian(0.002);
+      d.x_m = d.x_m * 1.02 + rng.gaussian(0.004);
+      d.y_m = d.y_m + 0.01 * d.x_m + rng.gaussian(0.004);
+      o = o.compose(d);
+      run.odom.push_back(o);
+    }
+    for (std::size_t i = 0; i < run.truth.size(); ++i) {
+      scans.push_back(std::make_unique<RangeScan>());
+      RangeScan* scan = scans.back().get();
+      test::make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, scan);
+      // A shorter laser: longer readings become the 30 m maximum (no return).
+      for (std::uint32_t k = 0; k < scan->beam_count; ++k) {
+        if (scan->ranges_m[k] > static_cast<float>(max_range_m)) scan->ranges_m[k] = scan->geometry.range_max_m;
+      }
+    }
+  }
+};
+
+// One run through the corridor; the trajectory (permanent then live poses) and stats.
+struct CorridorRun {
+  std::vector<std::int64_t> stamps;
+  std::vector<Pose2> poses;
+  SdpStats stats;
+  std::int32_t window_cells = 0;
+  double mapped_x0_m = 1e9;
+  double mapped_x1_m = -1e9;
+  bool map_ok = false;
+  std::uint32_t out_of_bounds = 0U;
+};
+
+CorridorRun run_corridor(const Corridor& c, double map_side_m, double period_travel_m) {
+  DpSlamOptions b = test::sim_options(5);
+  b.map_width_m = map_side_m;  // a lower bound: the window is at least 8 × the update reach
+  b.map_height_m = map_side_m;
+  b.beam.max_update_range_m = 2.5;
+  SdpOptions s = test::small_sdp_options();
+  s.period_travel_m = period_travel_m;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(b, s, 31));
+  test::CollectPoses sink;
+  rig.slam->set_permanent_sink(&sink);
+  for (std::size_t i = 0; i < c.scans.size(); ++i) {
+    OdometrySample o;
+    o.stamp_us = c.scans[i]->stamp_us;
+    o.pose = c.run.odom[i];
+    rig.slam->process(o, *c.scans[i]);
+  }
+  rig.slam->finish();
+  CorridorRun r;
+  r.stats = rig.slam->stats();
+  r.window_cells = rig.slam->bottom().map().width_cells();
+  r.map_ok = rig.slam->bottom().map().invariants_hold();
+  r.out_of_bounds = rig.slam->bottom().map().out_of_bounds_count();
+  rig.slam->for_each_permanent_cell([&r](double x, double, const CellObservation&) {
+    if (x < r.mapped_x0_m) r.mapped_x0_m = x;
+    if (x > r.mapped_x1_m) r.mapped_x1_m = x;
+  });
+  r.stamps = sink.stamps;
+  r.poses = sink.poses();
+  rig.slam->for_each_best_pose([&r](std::int64_t t, const Pose2& p) {
+    r.stamps.push_back(t);
+    r.poses.push_back(p);
+  });
+  return r;
+}
+
+}  // namespace
+
+// The DP map is a torus (sdp_slam.h; its exactness: tests/dpslam_structures). With a
+// window of 512 cells (25.6 m) the robot drives through it almost four times; segments
+// longer than the window allows end at the edge of their square of it, and the
+// permanent map, which has no edge, keeps the corridor beyond one window.
+TEST(SdpSlam, a_segment_ends_where_the_robot_leaves_its_square_of_the_dp_map) {
+  const Corridor c(30.0);
+  const CorridorRun r = run_corridor(c, 4.0, 10.0);
+  LONGS_EQUAL(512, r.window_cells);
+  CHECK(r.mapped_x1_m - r.mapped_x0_m > 2.0 * 25.6);
+  // 95 m in segments of at most 25.6 / 8 = 3.2 m from their start.
+  CHECK(r.stats.window_segmentations >= 95U / 4U);
+  CHECK(r.stats.segments >= r.stats.window_segmentations);
+  CHECK_TRUE(r.map_ok);
+  LONGS_EQUAL(0U, r.out_of_bounds);
+  LONGS_EQUAL(0U, r.stats.map_transfer_dropped);
+}

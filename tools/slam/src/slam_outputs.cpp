@@ -220,6 +220,7 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
   };
   std::string js;
   js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
+  js += "  \"window_segmentations\": " + u(st.window_segmentations) + ",\n";
   js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
         u(st.submaps_released) + ",\n";
   js += "  \"global_map_transfers\": {\"cells\": " + u(st.map_transfer_cells) + ", \"popped\": " +

@@ -102,6 +102,20 @@ class DpMap final : public TreeListener {
     // every search is the scan of the cell's list (cheap with few particles, e.g. SDP's
     // bottom level); results are identical either way, only the cost differs.
     bool owner_cell_index = true;
+    // A torus instead of a bounded area (SDP-SLAM's bottom level): each axis is rounded
+    // up to a power of two of tiles, W × H cells, and cell (ix, iy) is stored where
+    // (ix mod W, iy mod H) is, for every int32 coordinate: nothing is out of the map, so
+    // the robot may drive any distance. Cells a window apart share storage but not
+    // views: a lookup finds only its own lineage's observations (the top of this file),
+    // so distinct lineages never see each other's, wherever they are. A lineage must not
+    // meet ITSELF across the seam: the caller keeps each lineage's updates within a
+    // square of side W/2 (SDP-SLAM: segmentation when the robot leaves it, sdp_slam.h)
+    // and its lookups closer than W/2 to that square (BeamModel leaves out longer
+    // readings); then every answer is exact: the other copies of a looked-up cell are
+    // all outside the square.
+    // pop_observation() and location-based extraction give coordinates modulo the
+    // window (in [0, W)); unwrap_near() brings them back next to a known place.
+    bool wrap = false;
   };
 
   DpMap() = default;
@@ -131,12 +145,17 @@ class DpMap final : public TreeListener {
   std::int32_t height_cells() const { return height_cells_; }
   double resolution_m() const { return options_.resolution_m; }
   const Options& options() const { return options_; }
+  bool wraps() const { return wrap_; }
   bool in_bounds(std::int32_t ix, std::int32_t iy) const {
-    return ix >= 0 && iy >= 0 && ix < width_cells_ && iy < height_cells_;
+    return wrap_ || (ix >= 0 && iy >= 0 && ix < width_cells_ && iy < height_cells_);
   }
   // Cell containing world point (x_m, y_m) (floor). False iff outside the covered area
-  // (outputs untouched) or not a finite number.
+  // (outputs untouched) or not a finite number; with wrap, iff not finite or beyond
+  // 2^30 cells from the origin.
   bool world_to_cell(double x_m, double y_m, std::int32_t* ix, std::int32_t* iy) const;
+  // With wrap: moves (ix, iy) by whole windows to the copy nearest (near_ix, near_iy)
+  // (within half a window on each axis). Without wrap: no change.
+  void unwrap_near(std::int32_t* ix, std::int32_t* iy, std::int32_t near_ix, std::int32_t near_iy) const;
   // World coordinates of the centre of cell (ix, iy); no bounds check.
   void cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y_m) const;
 
@@ -184,11 +203,11 @@ class DpMap final : public TreeListener {
   void for_each_known_cell(NodeId particle, F&& f) const;
   // Fills row-major buffers of rect.width × rect.height with `particle`'s view:
   // values[i] (left untouched where unknown) and known[i] ∈ {0,1}. Cells outside the
-  // map are unknown. Returns the number of known cells.
+  // map are unknown (with wrap, every cell is inside). Returns the number of known cells.
   std::uint32_t fill_rect(NodeId particle, const CellRect& rect, CellObservation* values,
                           std::uint8_t* known) const;
   // Bounding rectangle (whole tiles, clipped to the map) of every tile ever written.
-  // False iff nothing was ever written.
+  // False iff nothing was ever written. With wrap, in window coordinates [0, W).
   bool touched_bounds(CellRect* out) const;
   // Entries (of all nodes) in one cell's list; 0 outside the map. For diagnostics/tests.
   std::uint32_t entries_in_cell(std::int32_t ix, std::int32_t iy) const;
@@ -255,8 +274,10 @@ class DpMap final : public TreeListener {
     std::uint32_t table_index;                   // back-reference into tile_table_
   };
 
+  // Masks are all ones without wrap (in_bounds() was checked), tiles − 1 with it.
   std::uint32_t tile_index(std::int32_t ix, std::int32_t iy) const {
-    return (static_cast<std::uint32_t>(iy) >> kSideLog2) * tiles_x_ + (static_cast<std::uint32_t>(ix) >> kSideLog2);
+    return ((static_cast<std::uint32_t>(iy) >> kSideLog2) & tile_mask_y_) * tiles_x_ +
+           ((static_cast<std::uint32_t>(ix) >> kSideLog2) & tile_mask_x_);
   }
   static std::uint32_t cell_in_tile(std::int32_t ix, std::int32_t iy) {
     return ((static_cast<std::uint32_t>(iy) & kSideMask) << kSideLog2) | (static_cast<std::uint32_t>(ix) & kSideMask);
@@ -319,6 +340,9 @@ class DpMap final : public TreeListener {
   std::int32_t height_cells_ = 0;
   std::uint32_t tiles_x_ = 0U;
   std::uint32_t tiles_y_ = 0U;
+  bool wrap_ = false;
+  std::uint32_t tile_mask_x_ = 0xFFFFFFFFU;
+  std::uint32_t tile_mask_y_ = 0xFFFFFFFFU;
   std::uint32_t* tile_table_ = nullptr;  // tiles_x_ · tiles_y_ entries: tile slot or kNone
   ArenaPool<Tile> tiles_pool_;
   Tile* tiles_ = nullptr;  // slot 0 of tiles_pool_ (slots are contiguous)

@@ -49,6 +49,13 @@ struct DpSlamOptions {
   // DpMap's (owner, cell) index: on for large particle counts (DP-SLAM at hundreds of
   // particles), off where memory matters more (SDP-SLAM's bottom level). Same results.
   bool map_owner_cell_index = true;
+  // The map as a torus (DpMap::Options::wrap) of at least width × height and at least
+  // 8 × (beam.max_update_range_m + 2 cells) on each side: no place is out of the map,
+  // provided each lineage keeps its updates within a square of half the window, e.g. its
+  // path within window/8 of its start. Set by SDP-SLAM, whose segments bound that
+  // (sdp_slam.h); plain DP-SLAM has one lineage for the whole run and keeps the bounded
+  // area. No key: it follows from the mode.
+  bool map_wrap = false;
   // [capacity]
   std::uint32_t ancestry_nodes_per_particle = capacity::kAncestryNodesPerParticle;
   std::uint32_t path_entries_per_particle = 64U;         // uncommitted poses per particle

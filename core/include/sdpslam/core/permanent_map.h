@@ -10,20 +10,24 @@
 // ACES). With a tag per cell, the map is drawn with each cell moved by its own level's
 // correction, frame_now ⊕ frame_at_copy⁻¹ (SdpSlam::for_each_permanent_cell).
 //
-// Layout (fixed memory from the Arena at init): a tile table, one u32 per tile of
-// capacity::kDpTileSideCells² cells over the DP map's area, and up to tile_capacity
-// tiles of 8-byte cells {hits, misses, tag}, taken in order on the first write into a
-// tile and never released (the permanent map only grows). A cell written by two levels
-// keeps the sum of their counts (accumulate(), which saturates keeping the ratio) and
-// the tag of the larger contribution: it is drawn with the correction of the level that
-// saw it most. Tag 0 = no data.
+// Layout (fixed memory from the Arena at init): up to tile_capacity tiles of
+// capacity::kDpTileSideCells² 8-byte cells {hits, misses, tag}, taken in order on the
+// first write into a tile and never released (the permanent map only grows), and an
+// open-addressing table (linear probing, twice the tiles rounded up to a power of two,
+// so at most half full) from a tile's coordinates to its slot. Cell coordinates are any
+// int32 in the DP map's cell frame (same origin and resolution): the area has no bound,
+// only the number of tiles does, so a building of any size keeps its map as long as
+// the tiles last. A cell written by two levels keeps the sum of their counts
+// (accumulate(), which saturates keeping the ratio) and the tag of the larger
+// contribution: it is drawn with the correction of the level that saw it most. Tag 0 =
+// no data.
 //
 // Compared with keeping the permanent map as one more node of the DP map, it costs 8
 // bytes per cell of each touched tile instead of ~32 bytes per known cell (an
 // observation slot and its pool links) in the shared observation pool, so the bottom level's map no longer competes with it.
 //
-// Errors are results and counters: a write outside the area or into a new tile when
-// every tile is taken returns false and is counted; the map stays consistent.
+// Errors are results and counters: a write with tag 0, or into a new tile when every
+// tile is taken, returns false and is counted; the map stays consistent.
 #include <cstddef>
 #include <cstdint>
 
@@ -44,32 +48,32 @@ class PermanentMap {
   PermanentMap(const PermanentMap&) = delete;
   PermanentMap& operator=(const PermanentMap&) = delete;
 
-  // Arena bytes init() needs for an area of width × height cells and tile_capacity
-  // tiles (at most the tiles the area holds are provisioned); 0 iff the sizes are out of
-  // range (an axis of 0 or over 2^20 cells, or no tiles).
-  static std::size_t required_bytes(std::int32_t width_cells, std::int32_t height_cells, std::uint32_t tile_capacity);
+  // Arena bytes init() needs for tile_capacity tiles; 0 iff tile_capacity is 0 or above
+  // capacity::kDpMaxTiles.
+  static std::size_t required_bytes(std::uint32_t tile_capacity);
 
-  // Carves its storage from `arena`. False iff the sizes are out of range or the arena is
-  // too small (the map then refuses every write). tile_capacity() is the requested
-  // capacity, or the tiles of the area if fewer. Call once.
-  bool init(Arena& arena, std::int32_t width_cells, std::int32_t height_cells, std::uint32_t tile_capacity);
+  // Carves its storage from `arena`. False iff tile_capacity is out of range or the arena
+  // is too small (the map then refuses every write). Call once.
+  bool init(Arena& arena, std::uint32_t tile_capacity);
 
-  // Adds (hits, misses) to cell (ix, iy) with `tag` (> 0). False, counted, iff the cell is
-  // outside the area, the tag is 0, or the cell's tile is new and every tile is taken.
+  // Adds (hits, misses) to cell (ix, iy) with `tag` (> 0). False, counted, iff the tag is
+  // 0 or the map is not initialised (refused_untagged), or the cell's tile is new and
+  // every tile is taken (refused_no_tile). O(1) expected.
   bool add(std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses, std::uint32_t tag);
 
-  // The cell (ix, iy); tag 0 when unknown or outside the area.
+  // The cell (ix, iy); tag 0 when unknown. O(1) expected.
   Cell cell(std::int32_t ix, std::int32_t iy) const;
 
-  // f(ix, iy, const Cell&) for every known cell, tile by tile in row-major tile order
-  // (deterministic), row-major within a tile.
+  // f(ix, iy, const Cell&) for every known cell, tile by tile in row-major order of the
+  // tiles' coordinates (deterministic, whatever order they were written in), row-major
+  // within a tile. O(tiles in the bounding box of the used ones).
   template <class F>
   void for_each_cell(F&& f) const;
 
   std::uint32_t tile_capacity() const { return tile_capacity_; }
   std::uint32_t tiles_used() const { return tiles_used_; }
   std::uint64_t known_cells() const { return known_cells_; }
-  std::uint64_t refused_out_of_area() const { return refused_out_of_area_; }
+  std::uint64_t refused_untagged() const { return refused_untagged_; }
   std::uint64_t refused_no_tile() const { return refused_no_tile_; }
   bool initialised() const { return table_ != nullptr; }
 
@@ -79,12 +83,22 @@ class PermanentMap {
   static constexpr std::uint32_t kCells = capacity::kDpTileCells;
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
 
-  bool in_area(std::int32_t ix, std::int32_t iy) const {
-    return table_ != nullptr && ix >= 0 && iy >= 0 && ix < width_cells_ && iy < height_cells_;
+  // A tile's key: its coordinates floor(i / kSide) as the high bits of the cell
+  // coordinates' two's complement (one key per tile over all of int32).
+  static std::uint64_t tile_key(std::int32_t ix, std::int32_t iy) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(iy) >> kSideLog2) << 32U) |
+           (static_cast<std::uint32_t>(ix) >> kSideLog2);
   }
-  // The tile-table slot of cell (ix, iy), which must be in the area.
-  std::uint32_t& tile_slot(std::int32_t ix, std::int32_t iy) const {
-    return table_[(static_cast<std::uint32_t>(iy) >> kSideLog2) * tiles_x_ + (static_cast<std::uint32_t>(ix) >> kSideLog2)];
+  // Table position of `key`: its slot's entry if the tile exists, else the empty entry
+  // where it would go.
+  std::uint32_t probe(std::uint64_t key) const {
+    std::uint32_t i = static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ULL) >> table_shift_);
+    while (table_[i] != kNone && keys_[table_[i]] != key) i = (i + 1U) & table_mask_;
+    return i;
+  }
+  // The slot of the tile holding (ix, iy), kNone if it has none.
+  std::uint32_t find_slot(std::int32_t ix, std::int32_t iy) const {
+    return table_ == nullptr ? kNone : table_[probe(tile_key(ix, iy))];
   }
   // Cell (ix, iy) inside the tile stored at `slot`.
   Cell& cell_in(std::uint32_t slot, std::int32_t ix, std::int32_t iy) const {
@@ -93,32 +107,33 @@ class PermanentMap {
     return cells_[static_cast<std::size_t>(slot) * kCells + in_tile];
   }
 
-  std::int32_t width_cells_ = 0;
-  std::int32_t height_cells_ = 0;
-  std::uint32_t tiles_x_ = 0U;
-  std::uint32_t tiles_y_ = 0U;
   std::uint32_t tile_capacity_ = 0U;
   std::uint32_t tiles_used_ = 0U;
-  std::uint32_t* table_ = nullptr;  // tiles_x_ × tiles_y_ slots (kNone = no tile)
-  Cell* cells_ = nullptr;           // tile_capacity_ × kCells
+  std::uint32_t* table_ = nullptr;  // table_mask_ + 1 entries: a tile slot, or kNone
+  std::uint32_t table_mask_ = 0U;
+  std::uint32_t table_shift_ = 63U;  // 64 − log2(table entries)
+  std::uint64_t* keys_ = nullptr;    // tile_capacity_: each slot's tile key
+  Cell* cells_ = nullptr;            // tile_capacity_ × kCells
+  // Bounding box of the used tiles, in tile coordinates (for_each_cell's order).
+  std::int32_t tx0_ = 0, ty0_ = 0, tx1_ = -1, ty1_ = -1;
   std::uint64_t known_cells_ = 0U;
-  std::uint64_t refused_out_of_area_ = 0U;
+  std::uint64_t refused_untagged_ = 0U;
   std::uint64_t refused_no_tile_ = 0U;
 };
 
 template <class F>
 void PermanentMap::for_each_cell(F&& f) const {
   if (table_ == nullptr) return;
-  for (std::uint32_t ty = 0; ty < tiles_y_; ++ty) {
-    for (std::uint32_t tx = 0; tx < tiles_x_; ++tx) {
-      const std::uint32_t slot = table_[ty * tiles_x_ + tx];
+  for (std::int64_t ty = ty0_; ty <= ty1_; ++ty) {
+    for (std::int64_t tx = tx0_; tx <= tx1_; ++tx) {
+      const auto ox = static_cast<std::int32_t>(tx * kSide);
+      const auto oy = static_cast<std::int32_t>(ty * kSide);
+      const std::uint32_t slot = find_slot(ox, oy);
       if (slot == kNone) continue;
       const Cell* tile = cells_ + static_cast<std::size_t>(slot) * kCells;
       for (std::uint32_t i = 0; i < kCells; ++i) {
         if (tile[i].tag == 0U) continue;
-        const auto ix = static_cast<std::int32_t>((tx << kSideLog2) + (i & (kSide - 1U)));
-        const auto iy = static_cast<std::int32_t>((ty << kSideLog2) + (i >> kSideLog2));
-        f(ix, iy, tile[i]);
+        f(ox + static_cast<std::int32_t>(i & (kSide - 1U)), oy + static_cast<std::int32_t>(i >> kSideLog2), tile[i]);
       }
     }
   }

@@ -11,6 +11,17 @@
 // initial pose is that restart pose and its final pose the particle's pose at the next
 // segmentation, and T_ab = final_a ⊕ initial_b⁻¹ (SegmentGraph's convention).
 //
+// The DP map is a torus (DpMap::Options::wrap) of at least [map] width_m × height_m,
+// so the robot never leaves it: a segment is one lineage of the ancestry tree and sees
+// only its own observations, so segments far apart may share the torus's storage. What
+// must not happen is a segment meeting itself across the seam: a segment also ends
+// (SegmentEnd::kWindow) when the bottom's best pose gets window/8 from the segment's
+// start, so its map updates (max_update_range_m around its path, checked ≤ window/8 at
+// init) stay in a square of half the window, and the beam model leaves out readings
+// longer than half the window. Cells popped from the torus are brought back next to
+// their submap's rectangle (DpMap::unwrap_near). The permanent map has no edge either
+// (permanent_map.h): memory bounds the area mapped, not the building's size.
+//
 // Top level (lines 7-12): the PGS (segment_graph.h) gets one level per segment, one node
 // per bottom particle. At anchorage every node's free-space skeleton (Fig. 2 (b)) is
 // extracted from its DP-map view around its path, in the submap frame, into fixed
@@ -108,6 +119,7 @@ struct SdpStepResult {
 struct SdpStats {
   std::uint64_t segments = 0U;            // segmentations done (levels added)
   std::uint64_t restart_refused = 0U;     // segmentation postponed: no room to restart
+  std::uint64_t window_segmentations = 0U;  // segments ended at the edge of their DP-map square
   std::uint64_t pgs_refused = 0U;         // add_level refused (should stay 0)
   std::uint64_t levels_made_permanent = 0U;
   std::uint64_t submaps_released = 0U;    // submaps freed when their level became permanent
@@ -498,6 +510,7 @@ class SdpSlam {
   // Current segment.
   bool started_ = false;
   Pose2 segment_start_pose_{};     // restart pose (current segment's initial pose)
+  double window_radius_m_ = 0.0;   // a segment ends when its path leaves this disc (1/8 window)
   std::int64_t segment_start_stamp_us_ = 0;  // exclusive
   std::int64_t last_processed_stamp_us_ = 0;
   double seg_box_[4] = {0.0, 0.0, 0.0, 0.0};  // best poses of the current segment

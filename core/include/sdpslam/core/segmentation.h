@@ -16,7 +16,9 @@
 
 namespace sdpslam {
 
-enum class SegmentEnd : std::uint8_t { kNone, kPeriod, kDispersion, kMaxLength };
+// kWindow: SdpSlam ended the segment because the robot reached the edge of the square
+// its lineage may use in the DP map's torus (sdp_slam.h), whatever the mode says.
+enum class SegmentEnd : std::uint8_t { kNone, kPeriod, kDispersion, kMaxLength, kWindow };
 const char* to_string(SegmentEnd reason);
 
 class Segmenter {
