@@ -4,10 +4,13 @@
 # mean and its worst seed rather than by one lucky run.
 #   - logs: `sdpslam run LOG --seed S`, then the relations metric (`sdpslam evaluate
 #     --relations`, mean absolute translational error, m);
-#   - worlds: `sdpslam simulate --seed S` (the seed also draws the sensor noise, so each
-#     seed is a different simulated run), `sdpslam run --seed S` on it, then the absolute
-#     trajectory error against the simulator's ground truth (ATE RMSE after SE(2)
-#     alignment, m). `simulate` has one built-in world, the paper's nested loops: "paper".
+#   - worlds: `sdpslam simulate --world NAME --seed S` (the seed also draws the sensor
+#     noise, so each seed is a different simulated run), `sdpslam run --seed S` on it, then
+#     the absolute trajectory error against the simulator's ground truth (ATE RMSE after
+#     SE(2) alignment, m). `simulate` has two built-in worlds: "paper", the paper's nested
+#     28 m / 80 m loops, and "large", a 203 m x 123 m building with 2.26 km of nested loops,
+#     an open hall and featureless corridors, scanned by a 270 deg 30 m laser (its log is
+#     about 130 MB per seed).
 # From each run's stats.json: CPU seconds of the whole run, worst per-scan CPU time, the
 # arena declared at init (the state's size), peak RSS, and the refusals (pools.*.exhausted,
 # pools.*.refused, pools.*.dropped, out_of_map_updates: capacity running out, which the
@@ -26,7 +29,7 @@
 # Environment: SEEDS (default "1 2 3 4 5"), JOBS (runs at once, default nproc), SHARED
 # (default ../shared beside the checkout), LOGS (default: every NAME in $SHARED/datasets
 # with a NAME.relations and a NAME.clf or NAME.clf.gz; LOGS="" runs none), WORLDS
-# (default "paper"; WORLDS="" runs none), RUN_ARGS (appended to every `sdpslam run`,
+# (default "paper large"; WORLDS="" runs none), RUN_ARGS (appended to every `sdpslam run`,
 # e.g. "--profile paper" or "--config my.ini"; default none). Use a Release build.
 # Without $SHARED/datasets only the worlds run. Default OUT_DIR: /tmp/sdpslam-accuracy.
 set -eu
@@ -48,7 +51,7 @@ if [ "${1:-}" = --job ]; then
     metric="relations m"
   else
     metric="ATE m"
-    if "$bin" simulate --seed "$seed" --out "$dir/sim" > "$dir/simulate.log" 2>&1; then
+    if "$bin" simulate --world "$name" --seed "$seed" --out "$dir/sim" > "$dir/simulate.log" 2>&1; then
       log=$dir/sim/sim.clf
     else
       status=simulate_failed
@@ -124,7 +127,7 @@ out=${2:-/tmp/sdpslam-accuracy}
 seeds=${SEEDS:-"1 2 3 4 5"}
 jobs=${JOBS:-$(nproc 2>/dev/null || getconf _NPROCESSORS_ONLN 2>/dev/null || echo 1)}
 shared=${SHARED:-$root/../shared}
-worlds=${WORLDS-paper}
+worlds=${WORLDS-paper large}
 run_args=${RUN_ARGS:-}
 bin="$build/tools/cli/sdpslam"
 [ -x "$bin" ] || { echo "accuracy.sh: no sdpslam binary in $build" >&2; exit 2; }
@@ -135,7 +138,10 @@ for s in $seeds; do
   case $s in *[!0-9]*) echo "accuracy.sh: seeds are non-negative integers, not '$s'" >&2; exit 2;; esac
 done
 for w in $worlds; do
-  [ "$w" = paper ] || { echo "accuracy.sh: unknown world '$w' (sdpslam simulate has one built-in world: paper)" >&2; exit 2; }
+  case $w in
+    paper|large) ;;
+    *) echo "accuracy.sh: unknown world '$w' (sdpslam simulate's built-in worlds: paper, large)" >&2; exit 2;;
+  esac
 done
 
 # has_log NAME: the dataset has ground-truth relations and a CARMEN log.

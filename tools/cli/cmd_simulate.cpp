@@ -1,9 +1,13 @@
-// `sdpslam simulate`: the synthetic benchmark of the SDP-SLAM paper (§IV): a robot drives
-// the nested 28 m / 80 m loops of the built-in world (or a world and route of your own)
-// and the run is written as a CARMEN log with its ground truth.
+// `sdpslam simulate`: the synthetic benchmarks. A robot drives a built-in world (the
+// SDP-SLAM paper's nested 28 m / 80 m loops, §IV, or a large building:
+// tools/sim/include/sdpslam/sim/builtin_worlds.h) or a world and route of your own, and
+// the run is written as a CARMEN log with its ground truth.
 //
-//   sdpslam simulate [--world FILE --route FILE] [--seed N] [--out DIR] [--speed M/S] ...
+//   sdpslam simulate [--world paper|large|FILE] [--route FILE] [--seed N] [--out DIR] ...
 //
+// A built-in world brings its own route and its robot and sensors (a preset); an option
+// given on the command line wins over the preset. A world file needs --route. A world
+// file named like a built-in world is given with a path (./large).
 // Writes DIR/sim.clf, DIR/ground_truth.txt, DIR/odometry.txt, DIR/world.txt and
 // DIR/world.pgm + .yaml + .png (tools/sim/include/sdpslam/sim/sim_output.h), then prints
 // a summary. Same arguments and seed → byte-identical files.
@@ -12,10 +16,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_common.h"
+#include "sdpslam/sim/builtin_worlds.h"
 #include "sdpslam/sim/sim_output.h"
 #include "sdpslam/sim/world.h"
 
@@ -24,41 +32,57 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
+// "paper, large"
+std::string builtin_world_names() {
+  std::string names;
+  for (const sim::BuiltinWorld& w : sim::builtin_worlds()) names += (names.empty() ? "" : ", ") + std::string(w.name);
+  return names;
+}
+
 struct SimulateArgs {
-  std::string world_path;
+  std::string world = "paper";  // a built-in world's name or a world file
   std::string route_path;
   std::string out_dir = "sim";
   double map_resolution_m = 0.05;
-  sim::SimulationOptions options;
+  sim::SimulationOptions options;  // as parsed: defaults plus what the user gave
+  // One per option bound to `options`: copies the user's value over `out` iff the option
+  // was given on the command line.
+  std::vector<std::function<void(const sim::SimulationOptions& given, sim::SimulationOptions* out)>> keep_given;
+  // One per option bound to `options`: " --name value" iff `preset` differs from the
+  // default there, else "" (for --help).
+  std::vector<std::function<std::string(const sim::SimulationOptions& preset)>> preset_change;
 };
 
 int run_simulate(const SimulateArgs& args) {
   sim::World world;
   sim::Route route;
   std::string error;
-  std::string world_name = "builtin";
-  if (!args.world_path.empty()) {
+  sim::SimulationOptions options = args.options;
+  const sim::BuiltinWorld* builtin = sim::find_builtin_world(args.world);
+  if (builtin != nullptr) {
+    world = builtin->world();
+    route = builtin->route();
+    options = builtin->preset(args.options);
+    for (const auto& keep : args.keep_given) keep(args.options, &options);
+  } else {
     if (args.route_path.empty()) {
-      std::fprintf(stderr, "sdpslam simulate: --world needs --route (the built-in route fits only the built-in world)\n");
+      std::fprintf(stderr,
+                   "sdpslam simulate: the world file %s needs --route (a built-in route fits only its own world; "
+                   "built-in worlds: %s)\n",
+                   args.world.c_str(), builtin_world_names().c_str());
       return kExitUsage;
     }
-    if (!sim::load_world_file(args.world_path, &world, &error)) {
+    if (!sim::load_world_file(args.world, &world, &error)) {
       std::fprintf(stderr, "sdpslam simulate: %s\n", error.c_str());
       return kExitBadInput;
     }
-    world_name = args.world_path;
-  } else {
-    world = sim::builtin_world();
   }
-  if (!args.route_path.empty()) {
-    if (!sim::load_route_file(args.route_path, &route, &error)) {
-      std::fprintf(stderr, "sdpslam simulate: %s\n", error.c_str());
-      return kExitBadInput;
-    }
-  } else {
-    route = sim::builtin_route();
+  if (!args.route_path.empty() && !sim::load_route_file(args.route_path, &route, &error)) {
+    std::fprintf(stderr, "sdpslam simulate: %s\n", error.c_str());
+    return kExitBadInput;
   }
-  if (!sim::validate_simulation_options(args.options, &error)) {
+  const std::string& world_name = args.world;
+  if (!sim::validate_simulation_options(options, &error)) {
     std::fprintf(stderr, "sdpslam simulate: %s\n", error.c_str());
     return kExitUsage;
   }
@@ -70,7 +94,7 @@ int run_simulate(const SimulateArgs& args) {
   };
   const auto t0 = std::chrono::steady_clock::now();
   sim::SimulationOutputs out;
-  const sim::OutputStatus status = sim::simulate_to_directory(world, world_name, route, args.options,
+  const sim::OutputStatus status = sim::simulate_to_directory(world, world_name, route, options,
                                                               args.map_resolution_m, args.out_dir, &out, &error,
                                                               on_progress);
   progress.finish();
@@ -87,7 +111,7 @@ int run_simulate(const SimulateArgs& args) {
   const sim::SimulationSummary& s = out.summary;
   const sim::OutputFiles files = sim::output_files(args.out_dir);
   std::printf("world %s: %zu walls; route %.3f m; seed %llu\n", world_name.c_str(), world.segments.size(), route_m,
-              static_cast<unsigned long long>(args.options.seed));
+              static_cast<unsigned long long>(options.seed));
   std::printf("simulated %.1f s, driven %.2f m, %llu scans, %llu odometry records%s\n", s.duration_s, s.distance_m,
               static_cast<unsigned long long>(s.scan_count), static_cast<unsigned long long>(s.odom_count),
               s.reached_goal ? "" : " (time ran out before the end of the route)");
@@ -105,49 +129,88 @@ int run_simulate(const SimulateArgs& args) {
   return kExitOk;
 }
 
+// Binds `--name` to the SimulationOptions field `field` picks and records how to keep
+// the user's value over a built-in world's preset.
+template <typename Field>
+void add_sim_option(CLI::App& app, SimulateArgs* args, const std::string& name, Field field,
+                    const std::string& help) {
+  CLI::Option* option = app.add_option(name, field(args->options), help)->capture_default_str();
+  args->keep_given.push_back([option, field](const sim::SimulationOptions& given, sim::SimulationOptions* out) {
+    if (option->count() > 0) field(*out) = field(given);
+  });
+  args->preset_change.push_back([name, field](const sim::SimulationOptions& preset) {
+    const sim::SimulationOptions defaults;
+    if (field(preset) == field(defaults)) return std::string();
+    std::ostringstream text;
+    text << ' ' << name << ' ' << field(preset);
+    return text.str();
+  });
+}
+
+// The built-in worlds with the options each one's preset sets.
+std::string world_help(const SimulateArgs& args) {
+  std::string help = "a built-in world, with its route, robot and laser (options given here win; the defaults "
+                     "shown are the paper world's):";
+  for (const sim::BuiltinWorld& w : sim::builtin_worlds()) {
+    std::string sets;
+    for (const auto& change : args.preset_change) sets += change(w.preset(sim::SimulationOptions{}));
+    help += std::string("\n  ") + w.name + ": " + w.description + (sets.empty() ? "" : "; sets" + sets);
+  }
+  help += "\nor a world file, one wall 'x1 y1 x2 y2' per line (needs --route)";
+  return help;
+}
+
 std::function<int()> setup_simulate(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  sim::SimulationOptions& o = args->options;
-  app.add_option("--world", args->world_path, "world file: one wall 'x1 y1 x2 y2' per line (default: built-in)");
-  app.add_option("--route", args->route_path, "route file: one waypoint 'x y' per line (default: built-in)");
-  app.add_option("--seed", o.seed, "random seed")->capture_default_str();
+  SimulateArgs* a = args.get();
+  CLI::Option* world = app.add_option("--world", args->world)->capture_default_str();
+  app.add_option("--route", args->route_path,
+                 "route file: one waypoint 'x y' per line (default: the built-in world's)");
+  add_sim_option(app, a, "--seed", [](auto& o) -> auto& { return o.seed; }, "random seed");
   app.add_option("--out", args->out_dir, "output directory")->capture_default_str();
-  app.add_option("--speed", o.robot.max_speed_mps, "top speed, m/s")->capture_default_str();
-  app.add_option("--accel", o.robot.max_accel_mps2, "acceleration limit, m/s^2")->capture_default_str();
-  app.add_option("--turn-rate", o.robot.max_angular_speed_radps, "angular speed limit, rad/s")->capture_default_str();
-  app.add_option("--wheel-base", o.robot.wheel_base_m, "wheel separation, m")->capture_default_str();
-  app.add_option("--physics-rate", o.physics_rate_hz, "simulation steps per second")->capture_default_str();
-  app.add_option("--odom-rate", o.odom_rate_hz, "ODOM records per second")->capture_default_str();
-  app.add_option("--laser-rate", o.laser.rate_hz, "laser scans per second")->capture_default_str();
-  app.add_option("--beams", o.laser.beam_count, "beams per scan")->capture_default_str();
-  app.add_option("--fov-deg", o.laser.fov_deg, "laser field of view, degrees")->capture_default_str();
-  app.add_option("--max-range", o.laser.max_range_m, "laser maximum range, m")->capture_default_str();
-  app.add_option("--range-noise", o.laser.range_noise_std_m, "range noise std, m")->capture_default_str();
-  app.add_option("--spurious-prob", o.laser.spurious_max_prob, "probability of a spurious max-range reading")
-      ->capture_default_str();
-  app.add_option("--odom-noise-trans", o.odometry.trans_m_per_sqrt_m,
-                 "along-track random walk, m per sqrt(m) travelled")
-      ->capture_default_str();
-  app.add_option("--odom-noise-rot", o.odometry.rot_rad_per_sqrt_rad, "heading random walk, rad per sqrt(rad) turned")
-      ->capture_default_str();
-  app.add_option("--odom-noise-rot-dist", o.odometry.rot_rad_per_sqrt_m,
-                 "heading random walk, rad per sqrt(m) travelled")
-      ->capture_default_str();
-  app.add_option("--odom-drift", o.odometry.wheel_radius_mismatch,
-                 "wheel radius mismatch (r_right - r_left)/r: steady heading drift")
-      ->capture_default_str();
-  app.add_option("--odom-scale", o.odometry.scale_error, "odometry distance scale error (fraction)")
-      ->capture_default_str();
-  app.add_option("--max-duration", o.max_duration_s, "stop after this many simulated seconds (0: automatic)")
-      ->capture_default_str();
+  add_sim_option(app, a, "--speed", [](auto& o) -> auto& { return o.robot.max_speed_mps; }, "top speed, m/s");
+  add_sim_option(app, a, "--accel", [](auto& o) -> auto& { return o.robot.max_accel_mps2; },
+                 "acceleration limit, m/s^2");
+  add_sim_option(app, a, "--turn-rate", [](auto& o) -> auto& { return o.robot.max_angular_speed_radps; },
+                 "angular speed limit, rad/s");
+  add_sim_option(app, a, "--wheel-base", [](auto& o) -> auto& { return o.robot.wheel_base_m; },
+                 "wheel separation, m");
+  add_sim_option(app, a, "--physics-rate", [](auto& o) -> auto& { return o.physics_rate_hz; },
+                 "simulation steps per second");
+  add_sim_option(app, a, "--odom-rate", [](auto& o) -> auto& { return o.odom_rate_hz; }, "ODOM records per second");
+  add_sim_option(app, a, "--laser-rate", [](auto& o) -> auto& { return o.laser.rate_hz; }, "laser scans per second");
+  add_sim_option(app, a, "--beams", [](auto& o) -> auto& { return o.laser.beam_count; }, "beams per scan");
+  add_sim_option(app, a, "--fov-deg", [](auto& o) -> auto& { return o.laser.fov_deg; },
+                 "laser field of view, degrees");
+  add_sim_option(app, a, "--max-range", [](auto& o) -> auto& { return o.laser.max_range_m; },
+                 "laser maximum range, m");
+  add_sim_option(app, a, "--range-noise", [](auto& o) -> auto& { return o.laser.range_noise_std_m; },
+                 "range noise std, m");
+  add_sim_option(app, a, "--spurious-prob", [](auto& o) -> auto& { return o.laser.spurious_max_prob; },
+                 "probability of a spurious max-range reading");
+  add_sim_option(app, a, "--odom-noise-trans", [](auto& o) -> auto& { return o.odometry.trans_m_per_sqrt_m; },
+                 "along-track random walk, m per sqrt(m) travelled");
+  add_sim_option(app, a, "--odom-noise-rot", [](auto& o) -> auto& { return o.odometry.rot_rad_per_sqrt_rad; },
+                 "heading random walk, rad per sqrt(rad) turned");
+  add_sim_option(app, a, "--odom-noise-rot-dist", [](auto& o) -> auto& { return o.odometry.rot_rad_per_sqrt_m; },
+                 "heading random walk, rad per sqrt(m) travelled");
+  add_sim_option(app, a, "--odom-drift", [](auto& o) -> auto& { return o.odometry.wheel_radius_mismatch; },
+                 "wheel radius mismatch (r_right - r_left)/r: steady heading drift");
+  add_sim_option(app, a, "--odom-scale", [](auto& o) -> auto& { return o.odometry.scale_error; },
+                 "odometry distance scale error (fraction)");
+  add_sim_option(app, a, "--max-duration", [](auto& o) -> auto& { return o.max_duration_s; },
+                 "stop after this many simulated seconds (0: automatic)");
   app.add_option("--map-resolution", args->map_resolution_m, "ground-truth map cell size, m")->capture_default_str();
+  world->description(world_help(*args));
   return [args]() { return run_simulate(*args); };
 }
 
 }  // namespace
 
 SDPSLAM_REGISTER_COMMAND(simulate, "simulate",
-                         "simulate the paper's nested-loop benchmark: CARMEN log + ground truth + map", 10,
+                         "simulate a benchmark world (the paper's nested loops, a large building, or your own): "
+                         "CARMEN log + ground truth + map",
+                         10,
                          setup_simulate);
 
 }  // namespace sdpslam::cli

@@ -5,17 +5,43 @@
 // `#` starts a comment (whole line or trailing); blank lines are ignored.
 // Route text format (one waypoint per line): `x y` in metres, same comment rules.
 //
-// The built-in world reproduces the simulated environment of the SDP-SLAM paper (§IV,
-// Fig. 4a): "an inner loop (loop 1) and an outer loop (loop 2) with lengths of 28 m and
-// 80 m", nested, corridor-like. Corridor centre-lines:
+// The paper world (builtin_world(), builtin_route()) reproduces the simulated environment
+// of the SDP-SLAM paper (§IV, Fig. 4a): "an inner loop (loop 1) and an outer loop (loop 2)
+// with lengths of 28 m and 80 m", nested, corridor-like. Corridor centre-lines:
 //   - outer loop: rectangle (0,0)-(24,16), centre-line length 2*(24+16) = 80 m exactly;
 //   - inner loop: rectangle (0,0)-(8,6),  centre-line length 2*(8+6)   = 28 m exactly.
 // The inner loop sits in the outer loop's south-west corner and shares its corridors
 // x in [0,8] on y=0 and y in [0,6] on x=0; two T-junctions, at (8,0) and (0,6), join them.
 // Corridors are 1.8 m wide. The walls carry alcoves, side rooms, pilasters (0.15 m deep)
 // and a pillar, so that scan matching sees features along the long corridors.
-// The built-in route starts at (4,0) heading east (+x), drives the inner loop (28 m),
+// The paper route starts at (4,0) heading east (+x), drives the inner loop (28 m),
 // passes the start and drives the outer loop (80 m) back to the start: 108 m in total.
+//
+// The large built-in world (large_world(), large_route()) is an accuracy benchmark for
+// big buildings: long corridors, loops of hundreds of metres, stretches where scan
+// matching is degenerate. Corridors are 3 m wide (walls 1.5 m either side of the
+// centre-line) on the centre-lines
+//   - outer ring: rectangle (0,0)-(200,120);
+//   - cross corridor x = 100, y in [0,120]; cross corridor y = 60, x in [0,200];
+// so the building is 203 m x 123 m of four solid blocks of 97 m x 57 m, with open
+// four-way crossings at (100,60) and T-junctions where the cross corridors meet the ring.
+// On its way east of x = 100 the y = 60 corridor crosses an open hall of 30 m x 20 m
+// (x in [135,165], y in [50,70]) holding four 0.6 m square pillars at least 3 m off the
+// centre-line. Along the walls, at irregular spacing drawn once from a fixed-seed
+// generator (the same world whatever the run's seed): pilasters (0.15 m), door recesses,
+// alcoves and side rooms behind doors. On purpose four stretches of 43-57 m have plain
+// walls on both sides, where a scan constrains nothing along the corridor: y = 60 for
+// x in [1.5,50.4] (from the T-junction at x = 0), y = 120 for x in [17.85,69.65],
+// x = 200 for y in [61.5,118.5] (the whole leg), y = 0 for x in [101.5,144.4]. No
+// feature lies within 12 m of a junction or of the hall.
+// The large route starts at (50,0) heading east, on exact centre-lines, and ends there:
+//   loop 1 around the south-west block (0..100 x 0..60), 320 m;
+//   loop 2 around the west half (0..100 x 0..120), 440 m;
+//   loop 3 around the whole ring, 640 m;
+//   then a figure of eight: east through the hall, around the north-east block (loop 4,
+//   320 m, closing at (100,60)), south, around the south-east block crossing the hall
+//   westwards (loop 5, 320 m, closing at (100,0)) and back to the start: 860 m;
+// 2260 m in all, every loop revisiting corridors driven before.
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -51,6 +77,29 @@ inline constexpr std::size_t kBuiltinInnerLoopEndWaypoint = 5;
 // The paper's nested-loop world and route described above.
 World builtin_world();
 Route builtin_route();
+
+inline constexpr double kLargeCorridorWidth_m = 3.0;
+inline constexpr double kLargeRingWidth_m = 200.0;   // outer ring centre-line, x extent
+inline constexpr double kLargeRingHeight_m = 120.0;  // outer ring centre-line, y extent
+inline constexpr double kLargeLoop1Length_m = 320.0;
+inline constexpr double kLargeLoop2Length_m = 440.0;
+inline constexpr double kLargeLoop3Length_m = 640.0;
+inline constexpr double kLargeHallLegLength_m = 860.0;  // loops 4 and 5 and the way back
+inline constexpr double kLargeRouteLength_m = 2260.0;
+// Waypoint indices where loops 1, 2 and 3 end (each on the start point).
+inline constexpr std::size_t kLargeLoop1EndWaypoint = 5;
+inline constexpr std::size_t kLargeLoop2EndWaypoint = 10;
+inline constexpr std::size_t kLargeLoop3EndWaypoint = 15;
+// The hall the y = 60 corridor crosses.
+inline constexpr double kLargeHallMinX_m = 135.0;
+inline constexpr double kLargeHallMaxX_m = 165.0;
+inline constexpr double kLargeHallMinY_m = 50.0;
+inline constexpr double kLargeHallMaxY_m = 70.0;
+
+// The large world and route described above.
+World large_world();
+Route large_route();
+
 // Heading of the route's first leg (radians); the robot starts on waypoint 0 facing it.
 double route_start_heading_rad(const Route& route);
 
