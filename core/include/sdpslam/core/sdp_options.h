@@ -72,23 +72,20 @@ struct SdpOptions {
   // not add up in one scan; it runs on the scans the bottom level skips (most of them:
   // it processes a scan per update_min_travel_m), and anyway after
   // capacity::kMaxDeferredTopWork processed scans in a row, so that it is never starved.
-  // Measured with the accurate profile (seed 1): Intel's worst scan 79-80 ms instead of
-  // 86-106 ms, same relations error; ACES worst 77-115 ms instead of 106-110 ms, but its
-  // submaps are released later, the observation pool runs shorter and the relations
-  // error rises (seeds 1 and 3: 0.101 and 0.122 m instead of 0.081 and 0.068 m). Off.
+  // The price: submaps are released later, so the observation pool runs shorter where
+  // it is tight, and the bottom level loses updates. Off.
   bool defer_top_work = false;
   // [sdp] fixed memory of the shared DP map in SDP mode (0 = keep the [map] values):
   // tiles that may hold data and observations for every live submap (the permanent
-  // submaps go to the permanent map below). Tiles peak at ~900 (Intel) and ~1300
-  // (ACES); the rest of the 64 MiB goes to observations, which ACES can still run short
-  // of: seed 9 needs 1.57 M (0.068 m with them all, 0.070 m at 1.505 M, 0.106 m at
-  // 1.46 M). Every refused update is counted (stats.json pools.observations).
+  // submaps go to the permanent map below). The state's 64 MiB budget is what sizes
+  // them: tiles with room to spare for an office floor's live submaps, observations the
+  // rest. A large floor can still run the observation pool short; every refused update
+  // is counted (stats.json pools.observations).
   std::uint32_t map_tile_capacity = 2500U;
   std::uint32_t map_observation_capacity = 1505000U;
   // [sdp] tiles of the global map's permanent part (permanent_map.h), 16 × 16 cells of
-  // 8 bytes each (2 KiB), over the DP map's area (at most the area's tiles are
-  // provisioned). A copy into a full map is refused and counted (map_transfer_dropped).
-  // Measured with the accurate profile at seed 1: Intel uses 1220, ACES 2610.
+  // 8 bytes each (2 KiB), wherever they are: 4096 tiles hold 2,600 m² of mapped floor at
+  // 5 cm. A copy into a full map is refused and counted (map_transfer_dropped).
   std::uint32_t permanent_map_tiles = 4096U;
   // [sdp] the DP map's (owner, cell) index (DpMap::Options::owner_cell_index) for the
   // bottom level: off by default, its ~17 MB would break the memory budget, and with N
@@ -113,16 +110,9 @@ struct SdpOptions {
   // the two frames, and the best combination's frames (permanent ones included) are
   // adjusted to agree with the constraints (pose graph: chain transforms with
   // segment_sigma_*, loops with loop_sigma_* behind a Cauchy kernel of scale
-  // loop_robust_chi). false (the default) = the paper's top level only. It pays off
-  // where the bottom level drifts little between loops: with [proposal] kind =
-  // scan_match Intel's relations error is 0.07, 0.12 and 0.50 m for seeds 1, 2 and 3;
-  // with the wide search below as well (profile accurate, sdp_profile.h) it is
-  // 0.060-0.113 m over seeds 1-5 (mean 0.077) with isotropic loop constraints and
-  // 0.061-0.083 m (mean 0.072) with direction-aware ones (below); ACES's 0.068-0.088 m
-  // (mean 0.080) and 0.070-0.116 m (mean 0.087). Holding weak search peaks for a second
-  // opinion (loop_search_confirm_score) then gives Intel 0.062-0.091 m (mean 0.074) and
-  // ACES 0.070-0.093 m (mean 0.077); over seeds 6-10, Intel 0.063-0.118 m and ACES
-  // 0.072-0.095 m, as without it but for 0.004 m either way.
+  // loop_robust_chi). false (the default) = the paper's top level only; the accurate
+  // profile (sdp_profile.h) turns it on with the wide search below. ICP alone only closes
+  // loops the bottom level has kept within its reach, which is why the wide search exists.
   bool loop_closure = false;
   std::uint32_t loop_points = 300U;  // obstacle points per submap, 16 .. capacity::kMaxIcpPoints
   double loop_icp_max_correspondence_m = 0.3;
@@ -171,9 +161,8 @@ struct SdpOptions {
   // loop_search_confirm_xy_m and loop_search_confirm_rad in the best combination's
   // frame): a second older submap, searched or already constrained to it. Two false
   // matches against different submaps seldom agree; a true loop seen weakly by each
-  // older submap it revisits does. ACES seed 4's last loop scored just under 0.45
-  // against two adjacent older submaps and stayed open (relations error 0.116 m); held
-  // and corroborated, it closes (0.071 m). Equal to loop_search_min_score: off.
+  // older submap it revisits does: a true loop seen only weakly still closes. Equal to
+  // loop_search_min_score: off.
   double loop_search_confirm_score = 0.40;     // (0, loop_search_min_score]
   double loop_search_confirm_xy_m = 0.30;      // [0, 10]
   double loop_search_confirm_rad = 0.05;       // [0, pi]
@@ -182,12 +171,10 @@ struct SdpOptions {
   // loop_search_drift_m × √hops is held the same way until a second older submap agrees;
   // hops = the fewest steps between the two levels along the chain and the other loop
   // constraints already recorded (the chain drifts like a random walk; a recorded loop is
-  // a short cut). Repeated structure matches metres off: on Intel and ACES, peaks 6 m
-  // off two levels apart (4 m per √hop) were accepted, and Intel seed 10's 5.8 m jump over 6 hops
-  // (2.4 m per √hop) pulled the map apart (relations error 0.118 m, 0.065 m held). True
-  // loops, measured over 20 runs, moved their submap at most 1.8 m per √hop (ACES' first
-  // loops, 7 m over 15-21 hops). With 2.0, seeds 1-10: Intel 0.059-0.081 m (mean 0.067,
-  // was 0.077), ACES 0.065-0.097 m (mean 0.080, unchanged). 0: off.
+  // a short cut). Repeated structure (doors, pillars at a regular pitch) makes peaks that
+  // are metres off and, alone, would pull the map apart; a true loop's correction grows
+  // like the chain's random-walk drift, so a lone peak far beyond it waits for a second
+  // opinion. 0: off.
   double loop_search_drift_m = 2.0;            // [0, 100]
   // Older submaps searched per level, largest overlaps first. A place revisited after a
   // long loop overlaps many older submaps (a corridor walked several times, rooms along

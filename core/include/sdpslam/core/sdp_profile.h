@@ -4,13 +4,14 @@
 //
 //  kPaper    — the paper's algorithm (SDP-SLAM §III): DpSlamOptions{} and SdpOptions{}
 //              as declared: odometry proposals in the bottom level, no loop closure.
-//  kAccurate — the most accurate configuration measured on the Intel and ACES logs
-//              (the default of the tools and the onboard program). Beyond the paper:
+//  kAccurate — the default of the tools and the onboard program, judged by the accuracy
+//              benchmark over every log and built-in world (tools/bench/accuracy.sh,
+//              worst seed). Beyond the paper:
 //              the bottom level draws each particle around its scan match to its own
 //              submap (Grisetti et al. 2007; every 8th beam scores a candidate, for the
 //              CPU budget), and the top level closes loops: ICP constraints between
 //              overlapping submaps of the best combination plus a wide correlative search
-//              (±6 m, ±0.35 rad) of each new submap against older ones it may revisit
+//              (±6 m, ±0.6 rad) of each new submap against older ones it may revisit
 //              (correlative_matcher.h), with the submap frames adjusted to them
 //              (frame_graph.h). 8 live PGS levels instead of 12, so that fewer submaps
 //              hold DP-map observations at once within the 64 MiB budget.
