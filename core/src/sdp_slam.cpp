@@ -214,19 +214,12 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   filter_->set_pose_sink(&ring_sink_);
   {
     // A segment's updates must stay within a square of half the window (DpMap's wrap
-    // contract): its path within window/8 of its start (segmentation, process()) and its
-    // beams' updates within max_update_range_m of the path, so that range (plus a cell
-    // for the rounding) must fit in window/8.
+    // contract): its path within window/8 of its start (process()) and its beams'
+    // updates within max_update_range_m of the path, which the filter's map options keep
+    // below window/8 (DpSlamOptions::map_wrap).
     const DpMap& map = filter_->map();
     const std::int32_t side = map.width_cells() < map.height_cells() ? map.width_cells() : map.height_cells();
     window_radius_m_ = 0.125 * map.resolution_m() * static_cast<double>(side);
-    if (b.beam.max_update_range_m + 2.0 * map.resolution_m() > window_radius_m_) {
-      std::snprintf(why_, sizeof why_,
-                    "observation.max_update_range_m %.3g m needs a map window of at least %.3g m "
-                    "(map.width_m and map.height_m)",
-                    b.beam.max_update_range_m, 8.0 * (b.beam.max_update_range_m + 2.0 * map.resolution_m()));
-      return false;
-    }
   }
   if (!permanent_map_.init(arena, s.permanent_map_tiles)) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving the permanent map");
