@@ -246,9 +246,10 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
 double DpSlamFilter::propose(std::uint32_t i, const Pose2& delta) {
   const Particle& p = particles_[i];
   if (options_.proposal == DpSlamOptions::Proposal::kScanMatch) {
-    // Improved proposal (Grisetti et al. 2007, §IV): match from the odometry prediction.
-    const Pose2 predicted = p.pose.compose(delta);
-    const ScanMatch m = match_scan(beam_, map_, p.node, rays_, predicted, options_.match, &view_);
+    // Improved proposal (Grisetti et al. 2007, §IV): from the odometry prediction, the
+    // mode of the likelihood times the motion model's density along the path.
+    const MotionPrior prior = motion_.prior(p.pose, delta);
+    const ScanMatch m = match_scan(beam_, map_, p.node, rays_, prior.predicted, options_.match, &prior, &view_);
     stats_.proposal_evaluations += m.evaluations;
     switch (m.outcome) {
       case ScanMatch::Outcome::kMatched: {

@@ -43,6 +43,23 @@ OdometryDelta MotionModel::sigmas(const OdometryDelta& d) const {
   return s;
 }
 
+MotionPrior MotionModel::prior(const Pose2& start, const Pose2& odom_delta) const {
+  const OdometryDelta d = decompose_odometry(odom_delta);
+  const OdometryDelta s = sigmas(d);
+  // With every noise parameter at zero the model is exact; a variance floor far below
+  // any map cell keeps the information finite.
+  constexpr double kMinVariance = 1e-12;
+  double var_along = s.trans_m * s.trans_m;
+  if (var_along < kMinVariance) var_along = kMinVariance;
+  MotionPrior p;
+  p.predicted = start.compose(odom_delta);  // = apply_odometry(start, d)
+  const double travel = start.heading_rad + d.rot1_rad;
+  p.along_cos = det::cos(travel);
+  p.along_sin = det::sin(travel);
+  p.info_along = 1.0 / var_along;
+  return p;
+}
+
 Pose2 MotionModel::sample(const Pose2& start, const Pose2& odom_delta, Rng& rng) const {
   const OdometryDelta d = decompose_odometry(odom_delta);
   const OdometryDelta s = sigmas(d);

@@ -29,7 +29,8 @@ struct LogSumExp {
 }  // namespace
 
 ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, const ScanRays& rays,
-                     const Pose2& initial, const ScanMatcherOptions& options, ViewCache* view) {
+                     const Pose2& initial, const ScanMatcherOptions& options, const MotionPrior* prior,
+                     ViewCache* view) {
   if (view != nullptr && view->ready()) view->begin(map, particle);
   else view = nullptr;
   const std::uint32_t stride = options.beam_stride == 0U ? 1U : options.beam_stride;
@@ -37,13 +38,15 @@ ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, 
     return view != nullptr ? model.log_likelihood_strided(*view, map, rays, pose, stride, score)
                            : model.log_likelihood_strided(map, particle, rays, pose, stride, score);
   };
+  auto log_prior = [prior](const Pose2& pose) { return prior != nullptr ? prior->log_density(pose) : 0.0; };
   ScanMatch m;
   m.pose = initial;
   BeamScore score;
-  double best = score_at(initial, &score);
+  double best_likelihood = score_at(initial, &score);
+  double best = best_likelihood + log_prior(initial);  // the objective: likelihood × prior
   m.evaluations = 1U;
   m.beams = score.beams;
-  m.log_likelihood = best;
+  m.log_likelihood = best_likelihood;
   m.neighbourhood_log_likelihood = best;
   if (score.beams == 0U || score.beams < options.min_beams) {
     m.outcome = ScanMatch::Outcome::kTooFewBeams;
@@ -67,28 +70,32 @@ ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, 
                               Pose2{0.0, -lin, 0.0}, Pose2{0.0, 0.0, ang}, Pose2{0.0, 0.0, -ang}};
       Pose2 step_best = pose;
       double step_score = best;
+      double step_likelihood = best_likelihood;
       for (const Pose2& mv : moves) {
         const Pose2 cand = pose.compose(mv);
-        const double s = score_at(cand, nullptr);
+        const double l = score_at(cand, nullptr);
+        const double s = l + log_prior(cand);
         ++m.evaluations;
         if (finest) last_level.add(s);
         if (s > step_score) {
           step_score = s;
+          step_likelihood = l;
           step_best = cand;
         }
       }
       if (!(step_score > best)) break;
       best = step_score;
+      best_likelihood = step_likelihood;
       pose = step_best;
     }
     lin *= 0.5;
     ang *= 0.5;
   }
   m.pose = pose;
-  m.log_likelihood = best;
+  m.log_likelihood = best_likelihood;
   m.neighbourhood_log_likelihood = last_level.log_mean();
   const double temperature = model.options().likelihood_temperature;
-  const double mean_per_beam = best * temperature / static_cast<double>(score.beams);
+  const double mean_per_beam = best_likelihood * temperature / static_cast<double>(score.beams);
   m.outcome = mean_per_beam >= options.min_mean_log_likelihood ? ScanMatch::Outcome::kMatched
                                                                : ScanMatch::Outcome::kScoreTooLow;
   return m;

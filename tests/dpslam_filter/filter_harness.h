@@ -35,6 +35,8 @@ struct FilterRig {
   Arena arena;
   std::unique_ptr<DpSlamFilter> filter = std::make_unique<DpSlamFilter>();
   std::unique_ptr<RangeScan> scan = std::make_unique<RangeScan>();
+  double laser_sigma_m = 0.0;  // range noise of the simulated laser (0: exact ranges)
+  Rng laser_noise{99U};
 
   bool init(const DpSlamOptions& o, std::uint64_t seed) {
     buffer.assign(DpSlamFilter::required_arena_bytes(o), 0);
@@ -43,7 +45,8 @@ struct FilterRig {
   }
   // Feeds scan i of `run`; returns the step result.
   StepResult step(const SimRun& run, const std::vector<Segment>& world, std::size_t i) {
-    make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, scan.get());
+    make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, scan.get(),
+              laser_sigma_m > 0.0 ? &laser_noise : nullptr, laser_sigma_m);
     OdometrySample od;
     od.stamp_us = static_cast<std::int64_t>(i) * 100000;
     od.pose = run.odom[i];

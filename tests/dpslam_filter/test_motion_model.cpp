@@ -1,5 +1,5 @@
 // Odometry motion model: decomposition round trip, unbiased samples whose spread
-// follows the alpha parameters.
+// follows the alpha parameters, and the Gaussian prior that approximates their density.
 #include <CppUTest/TestHarness.h>
 
 #include <cmath>
@@ -77,4 +77,47 @@ TEST(MotionModel, same_seed_same_samples) {
     const Pose2 q = m.sample(Pose2{}, Pose2{0.3, 0.0, 0.1}, b);
     CHECK(p.x_m == q.x_m && p.y_m == q.y_m && p.heading_rad == q.heading_rad);
   }
+}
+
+// MotionPrior is the density of sample()'s position along the direction of travel: the
+// squared Mahalanobis distance −2·log_density of samples is χ² with 1 degree of freedom
+// (mean 1); a move across the path or a turn costs nothing.
+TEST(MotionModel, the_prior_is_the_density_of_the_samples_along_the_path) {
+  MotionModelOptions o;
+  o.alpha_rot_from_rot = 0.02;
+  o.alpha_rot_from_trans = 0.002;
+  o.alpha_trans_from_trans = 0.01;
+  o.alpha_trans_from_rot = 0.001;
+  o.min_sigma_trans_m = 0.002;
+  o.min_sigma_rot_rad = 0.002;
+  const MotionModel m(o);
+  const Pose2 start{3.0, -2.0, 2.5};
+  for (const Pose2& delta : {Pose2{0.3, 0.05, 0.2}, Pose2{-0.25, 0.02, -0.1}, Pose2{0.4, 0.0, 0.0}}) {
+    const MotionPrior prior = m.prior(start, delta);
+    const Pose2 want = start.compose(delta);
+    DOUBLES_EQUAL(want.x_m, prior.predicted.x_m, 1e-12);
+    DOUBLES_EQUAL(want.y_m, prior.predicted.y_m, 1e-12);
+    DOUBLES_EQUAL(0.0, prior.log_density(prior.predicted), 0.0);
+    const Pose2 across{prior.predicted.x_m - 0.1 * prior.along_sin, prior.predicted.y_m + 0.1 * prior.along_cos, 1.0};
+    DOUBLES_EQUAL(0.0, prior.log_density(across), 1e-12);
+    Rng rng(11);
+    const int n = 40000;
+    double chi2 = 0.0;
+    for (int i = 0; i < n; ++i) chi2 += -2.0 * prior.log_density(m.sample(start, delta, rng));
+    DOUBLES_EQUAL(1.0, chi2 / n, 0.03);
+  }
+}
+
+TEST(MotionModel, the_prior_of_a_robot_that_did_not_move_is_tight_and_finite) {
+  const MotionModel m{MotionModelOptions{}};
+  const MotionPrior prior = m.prior(Pose2{1.0, 1.0, 0.3}, Pose2{});
+  // A centimetre ahead is far for a robot that stood still (floor 5 mm): log density −2.
+  DOUBLES_EQUAL(-2.0, prior.log_density(Pose2{1.0 + 0.01 * std::cos(0.3), 1.0 + 0.01 * std::sin(0.3), 0.3}), 1e-9);
+  // With every noise parameter zero the model is exact, the information finite.
+  MotionModelOptions zero;
+  zero.alpha_rot_from_rot = zero.alpha_rot_from_trans = zero.alpha_trans_from_trans = zero.alpha_trans_from_rot = 0.0;
+  zero.min_sigma_trans_m = zero.min_sigma_rot_rad = 0.0;
+  const MotionPrior exact = MotionModel(zero).prior(Pose2{}, Pose2{0.5, 0.0, 0.0});
+  CHECK(std::isfinite(exact.log_density(Pose2{0.6, 0.1, 0.1})));
+  CHECK(exact.log_density(Pose2{0.6, 0.1, 0.1}) < -1e6);
 }

@@ -25,8 +25,9 @@ struct DpSlamOptions {
   // [proposal]: how a particle's new pose is drawn.
   //  kOdometry  — the paper's: sample the odometry motion model (motion_model.h).
   //  kScanMatch — the improved proposal (Grisetti et al. 2007, §IV): from the
-  //    odometry-predicted pose, hill-climb against the particle's own map view
-  //    (scan_matcher.h), then sample N(match, diag(sample_sigma_xy², ·, sample_sigma_rot²))
+  //    odometry-predicted pose, hill-climb the likelihood against the particle's own map
+  //    view times the motion model's density along the path (scan_matcher.h,
+  //    MotionPrior in motion_model.h), then sample N(match, diag(sample_sigma_xy², ·, sample_sigma_rot²))
   //    and weight by the likelihood at the match (weighting below). A failed match falls
   //    back to the odometry proposal for that particle (counted in DpSlamStats).
   enum class Proposal : std::uint8_t { kOdometry, kScanMatch };

@@ -37,6 +37,36 @@ OdometryDelta decompose_odometry(const Pose2& delta);
 // The pose reached from `start` by executing `d` exactly.
 Pose2 apply_odometry(const Pose2& start, const OdometryDelta& d);
 
+// The motion model's density around its prediction along the direction of travel. To
+// first order in the rot1/trans/rot2 noise, an error moves the pose by δtrans along the
+// direction of travel u (start heading + rot1) and by trans·δrot1 across it, so the
+// position along u is Gaussian with variance σ_trans², independent of the rest: this is
+// that marginal. Across the path and in heading it says nothing.
+//
+// Why this part only: the scan matcher of the improved proposal maximises the
+// observation likelihood times this density (the proposal's target p(z | m, x)·p(x | x', u),
+// Grisetti, Stachniss & Burgard 2007, eq. 9). Along a plain corridor the map does not
+// fix the position along the path, and the likelihood alone has spurious optima there
+// (a scan fits best where its hits fall on the dots the previous scans drew, so every
+// step is pulled towards the last one and corridors come out short); the prior keeps
+// the odometry's travel where the map is silent. Across the path and in heading, walls
+// constrain the match almost everywhere, and the model's spread there (millimetres per
+// step, a well-calibrated robot) would hold the match to a real robot's heading drift.
+// O(1); no heap.
+struct MotionPrior {
+  Pose2 predicted;          // the odometry prediction: the density's mode
+  double along_cos = 1.0;   // direction of travel u
+  double along_sin = 0.0;
+  double info_along = 0.0;  // 1 / σ_trans², 1/m²
+
+  // log density at `pose` up to a constant: −½·(e·u)²/σ_trans², e = pose − predicted.
+  // 0 at the prediction (and anywhere across the path), negative elsewhere.
+  double log_density(const Pose2& pose) const {
+    const double along = (pose.x_m - predicted.x_m) * along_cos + (pose.y_m - predicted.y_m) * along_sin;
+    return -0.5 * info_along * along * along;
+  }
+};
+
 class MotionModel {
  public:
   MotionModel() = default;
@@ -45,6 +75,8 @@ class MotionModel {
   // One sample of the pose reached from `start` after the odometry displacement
   // `odom_delta` = between(odom_prev, odom_now).
   Pose2 sample(const Pose2& start, const Pose2& odom_delta, Rng& rng) const;
+  // Gaussian approximation of sample()'s density from `start` (see MotionPrior).
+  MotionPrior prior(const Pose2& start, const Pose2& odom_delta) const;
   // The standard deviations (rot1, trans, rot2) used for this displacement.
   OdometryDelta sigmas(const OdometryDelta& d) const;
 

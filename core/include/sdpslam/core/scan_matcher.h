@@ -6,6 +6,12 @@
 // climbing on the filter's own observation model (beam_model.h) evaluated on every
 // beam_stride-th beam.
 //
+// The objective is the tempered log-likelihood plus, when a motion prior is given, the
+// log of the motion model's density along the direction of travel (motion_model.h,
+// MotionPrior): towards the mode of the improved proposal's target p(z | m, x)·p(x | x', u)
+// rather than of the likelihood alone, so that where the map does not fix the position
+// along the path (a plain corridor) the match keeps the odometry's travel.
+//
 // Hill climbing: from `initial`, each iteration scores the six neighbours
 // (±linear_step along the robot's x and y, ±angular_step in heading) and moves to the
 // best one if it beats the current pose; when no neighbour improves (or max_iterations
@@ -23,6 +29,7 @@
 
 #include "sdpslam/core/beam_model.h"
 #include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/motion_model.h"
 #include "sdpslam/core/pose2.h"
 
 namespace sdpslam {
@@ -43,17 +50,21 @@ struct ScanMatch {
   Outcome outcome = Outcome::kTooFewBeams;
   Pose2 pose;                        // the match (== initial unless kMatched or kScoreTooLow)
   double log_likelihood = 0.0;       // at `pose`, beam_stride beams, tempered as the model is
-  // log of the mean likelihood over the poses evaluated in the last (finest) level,
-  // GMapping's neighbourhood weight, same beams and tempering as log_likelihood.
+  // log of the mean of likelihood × prior over the poses evaluated in the last (finest)
+  // level, GMapping's neighbourhood weight (an estimate of the improved proposal's
+  // normaliser), same beams and tempering as log_likelihood.
   double neighbourhood_log_likelihood = 0.0;
   std::uint32_t evaluations = 0U;    // observation-model evaluations spent
   std::uint32_t beams = 0U;          // return beams per evaluation
 };
 
 // Refines `initial` for `particle`'s map; see the header comment. Options are taken as
-// given (DpSlamOptions::validate() range-checks them). `view` (may be null) remembers the
-// cells read (view_cache.h): same result, each distinct cell looked up in the map once.
+// given (DpSlamOptions::validate() range-checks them). `prior` (may be null: the
+// likelihood alone) is the motion model's density around the odometry prediction, which
+// is normally `initial`. `view` (may be null) remembers the cells read (view_cache.h):
+// same result, each distinct cell looked up in the map once.
 ScanMatch match_scan(const BeamModel& model, const DpMap& map, NodeId particle, const ScanRays& rays,
-                     const Pose2& initial, const ScanMatcherOptions& options, ViewCache* view = nullptr);
+                     const Pose2& initial, const ScanMatcherOptions& options,
+                     const MotionPrior* prior = nullptr, ViewCache* view = nullptr);
 
 }  // namespace sdpslam
