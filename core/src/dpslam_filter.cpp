@@ -9,9 +9,29 @@
 namespace sdpslam {
 namespace {
 
-class NullSink final : public PoseSink {
+// Forwards committed poses to the filter's sink (if any) and keeps those of the scans in
+// the restart ring: restart_segment() places those scans by their poses, which the
+// lineage no longer holds once committed.
+class SeedSink final : public PoseSink {
  public:
-  void on_committed(std::int64_t, const Pose2&) override {}
+  SeedSink(PoseSink* next, const std::int64_t* stamps_us, std::uint32_t count, Pose2* poses, bool* known)
+      : next_(next), stamps_us_(stamps_us), count_(count), poses_(poses), known_(known) {}
+  void on_committed(std::int64_t stamp_us, const Pose2& pose) override {
+    for (std::uint32_t k = 0; k < count_; ++k) {
+      if (stamps_us_[k] == stamp_us) {
+        poses_[k] = pose;
+        known_[k] = true;
+      }
+    }
+    if (next_ != nullptr) next_->on_committed(stamp_us, pose);
+  }
+
+ private:
+  PoseSink* next_;
+  const std::int64_t* stamps_us_;
+  std::uint32_t count_;
+  Pose2* poses_;
+  bool* known_;
 };
 
 constexpr std::size_t kSlack = 64U;  // alignment padding per carved array
@@ -114,6 +134,9 @@ bool DpSlamFilter::init(const DpSlamOptions& options, Arena& arena, std::uint64_
 
 void DpSlamFilter::first_scan(const OdometrySample& odom, const RangeScan& scan, StepResult* result) {
   prepare_rays(scan, &rays_);
+  rays_stamp_us_ = scan.stamp_us;
+  seed_head_ = 0U;
+  seed_count_ = 0U;
   const Pose2 origin{};
   const NodeId root = tree_.create_root();
   std::uint32_t dropped = 0U;
@@ -131,8 +154,8 @@ void DpSlamFilter::first_scan(const OdometrySample& odom, const RangeScan& scan,
   }
   if (root != kNoNode && particles_[0].node != root) tree_.set_active(root, false);
   tree_.prune(&map_);
-  NullSink null_sink;
-  result->poses_committed = tree_.drain_committed(sink_ != nullptr ? *sink_ : static_cast<PoseSink&>(null_sink));
+  SeedSink seed_sink(sink_, seed_stamp_us_, seed_count_, seed_pose_, seed_committed_);
+  result->poses_committed = tree_.drain_committed(seed_sink);
   started_ = true;
   last_odom_ = odom;
   last_best_pose_ = origin;
@@ -163,7 +186,18 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   }
 
   const std::uint32_t n = particle_count_;
+  // The scan in rays_ becomes one of the previous scans (see restart_segment()).
+  const std::uint32_t slot = seed_count_ < kSeedScans ? (seed_head_ + seed_count_) % kSeedScans : seed_head_;
+  seed_rays_[slot] = rays_;
+  seed_stamp_us_[slot] = rays_stamp_us_;
+  seed_committed_[slot] = false;
+  if (seed_count_ < kSeedScans) {
+    ++seed_count_;
+  } else {
+    seed_head_ = (seed_head_ + 1U) % kSeedScans;
+  }
   prepare_rays(scan, &rays_);
+  rays_stamp_us_ = scan.stamp_us;
   // 1-2. propagate and weight.
   for (std::uint32_t i = 0; i < n; ++i) log_w_[i] = particles_[i].log_weight + propose(i, delta);
   if (!normalize_log_weights(log_w_, n, w_)) ++stats_.degenerate_weight_count;
@@ -216,8 +250,8 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   }
   // 5. prune/merge, commit.
   tree_.prune(&map_);
-  NullSink null_sink;
-  result.poses_committed = tree_.drain_committed(sink_ != nullptr ? *sink_ : static_cast<PoseSink&>(null_sink));
+  SeedSink seed_sink(sink_, seed_stamp_us_, seed_count_, seed_pose_, seed_committed_);
+  result.poses_committed = tree_.drain_committed(seed_sink);
 
   std::uint32_t new_best = 0U;
   for (std::uint32_t m = 0; m < n; ++m) {
@@ -297,7 +331,35 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
     ++restart_refused_count_;
     return false;
   }
+  // The previous scans go where the best particle's lineage put them, relative to
+  // start_pose as they were to its pose (a scan whose pose the lineage no longer holds,
+  // e.g. one from before the last restart, is left out).
+  if (seed_count_ > 0U) {
+    const Pose2 best_inverse = particles_[best_index_].pose.inverse();
+    Pose2 at[kSeedScans];
+    bool found[kSeedScans] = {};
+    for (std::uint32_t k = 0; k < seed_count_; ++k) {
+      at[k] = seed_pose_[k];  // committed: on every lineage
+      found[k] = seed_committed_[k];
+    }
+    tree_.for_each_pose_from_root(particles_[best_index_].node, [&](std::int64_t stamp_us, const Pose2& pose) {
+      for (std::uint32_t k = 0; k < seed_count_; ++k) {
+        if (seed_stamp_us_[k] == stamp_us) {
+          at[k] = pose;
+          found[k] = true;
+        }
+      }
+    });
+    for (std::uint32_t k = 0; k < seed_count_; ++k) {
+      if (found[k]) {
+        stats_.map_updates_dropped +=
+            beam_.update_map(map_, root, seed_rays_[k], start_pose.compose(best_inverse.compose(at[k])));
+      }
+    }
+  }
   stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose);
+  seed_count_ = 0U;  // the next segment starts from its own scans
+  seed_head_ = 0U;
   for (std::uint32_t i = 0; i < particle_count_; ++i) {
     NodeId c = tree_.add_child(root);
     if (c == kNoNode) {  // cannot happen after the capacity check; degraded path anyway

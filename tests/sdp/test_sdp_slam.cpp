@@ -292,36 +292,45 @@ TEST(SdpSlam, forgotten_permanent_levels_stay_where_they_were_copied) {
 }
 
 // Beyond the paper: the wide loop search finds constraints the top level's ICP cannot
-// (the chain placed the submaps too far off for its basin), and the run stays on the
-// truth at least as well as with the ICP constraints alone.
+// (the chain placed the submaps too far off for its basin), and the runs stay on the
+// truth better than with the ICP constraints alone (mean over seeds: one run of this
+// small world swings by a factor of two with the seed).
 TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
   const test::ScanSet set(3);
-  SdpOptions s = test::small_sdp_options();
-  s.loop_closure = true;
-  test::SdpRig a;
-  CHECK_TRUE(a.init(test::sim_options(5), s, 21));
-  test::CollectPoses sa;
-  const Trace ta = run_sdp(a, set, &sa);
-  s.loop_search_window_m = 3.0;
-  test::SdpRig b;
-  CHECK_TRUE(b.init(test::sim_options(5), s, 21));
-  test::CollectPoses sb;
-  const Trace tb = run_sdp(b, set, &sb);
-  const SdpStats& st = b.slam->stats();
-  CHECK(st.loop_searches > 0U);
-  CHECK(st.loop_search_closed > 0U);
-  // Every search ends in exactly one outcome (a held peak nobody agreed with is its own).
-  LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
-                                    st.loop_search_refuted + st.loop_search_closed +
-                                    (st.loop_search_held - st.loop_search_corroborated));
-  CHECK(st.loop_records_added > a.slam->stats().loop_records_added);
-  const double icp_only_m = mean_error_to_truth(ta, set);
-  const double search_m = mean_error_to_truth(tb, set);
-  std::printf("\n  wide loop search: mean position error %.3f m (ICP constraints only %.3f m), %llu searches, %llu closed\n",
-              search_m, icp_only_m, static_cast<unsigned long long>(st.loop_searches),
-              static_cast<unsigned long long>(st.loop_search_closed));
-  CHECK(search_m < icp_only_m);  // measured: 0.386 m against 0.509 m (isotropic: 0.319, 0.448)
-  CHECK_TRUE(b.slam->graph().invariants_hold());
+  double icp_only_m = 0.0;
+  double search_m = 0.0;
+  std::uint64_t searches = 0U;
+  std::uint64_t closed = 0U;
+  for (std::uint64_t seed = 21U; seed <= 23U; ++seed) {
+    SdpOptions s = test::small_sdp_options();
+    s.loop_closure = true;
+    test::SdpRig a;
+    CHECK_TRUE(a.init(test::sim_options(5), s, seed));
+    test::CollectPoses sa;
+    const Trace ta = run_sdp(a, set, &sa);
+    s.loop_search_window_m = 3.0;
+    test::SdpRig b;
+    CHECK_TRUE(b.init(test::sim_options(5), s, seed));
+    test::CollectPoses sb;
+    const Trace tb = run_sdp(b, set, &sb);
+    const SdpStats& st = b.slam->stats();
+    CHECK(st.loop_searches > 0U);
+    CHECK(st.loop_search_closed > 0U);
+    // Every search ends in exactly one outcome (a held peak nobody agreed with is its own).
+    LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
+                                      st.loop_search_refuted + st.loop_search_closed +
+                                      (st.loop_search_held - st.loop_search_corroborated));
+    CHECK(st.loop_records_added > a.slam->stats().loop_records_added);
+    CHECK_TRUE(b.slam->graph().invariants_hold());
+    icp_only_m += mean_error_to_truth(ta, set) / 3.0;
+    search_m += mean_error_to_truth(tb, set) / 3.0;
+    searches += st.loop_searches;
+    closed += st.loop_search_closed;
+  }
+  std::printf("\n  wide loop search, seeds 21-23: mean position error %.3f m (ICP constraints only %.3f m), %llu "
+              "searches, %llu closed\n",
+              search_m, icp_only_m, static_cast<unsigned long long>(searches), static_cast<unsigned long long>(closed));
+  CHECK(search_m < icp_only_m);
 }
 
 // A peak between loop_search_confirm_score and loop_search_min_score closes a loop only

@@ -115,12 +115,16 @@ class DpSlamFilter {
   // their map views and paths (the finished segment's submaps) remain readable and can
   // no longer change (no particle descends from them any more); every particle then
   // restarts at `start_pose` on one fresh root (a new tree of the forest) with an empty
-  // map, except that the last processed scan is written into that root at start_pose,
-  // so the new submap begins with what the robot sees where it starts. Weights become
-  // uniform. Poses are not recorded on the new root (start_pose is the finished
-  // segment's last pose). Returns false, changing nothing, iff the filter has not
-  // processed a scan yet or the node pool cannot hold the root and the particles'
-  // children (restart_refused_count() bumps). O(N + beams).
+  // map, except that the last processed scans are written into that root: the last at
+  // start_pose, and the kSeedScans before it where the best particle's lineage put them,
+  // relative to start_pose as they were to its pose. The new submap so begins with what
+  // the robot saw from several viewpoints where it starts: the next scans are matched
+  // against it, and a single scan is a fragile reference (its far walls are sparse
+  // dots, which fit a wrong heading during a turn about as well as the right one).
+  // Weights become uniform. Poses are not recorded on the new root (start_pose is the
+  // finished segment's last pose). Returns false, changing nothing, iff the filter has
+  // not processed a scan yet or the node pool cannot hold the root and the particles'
+  // children (restart_refused_count() bumps). O(N + lineage depth + kSeedScans · beams).
   bool restart_segment(const Pose2& start_pose);
   // Makes an anchored node inactive and prunes, so its observations and poses are freed
   // once nothing descends from it. False (nothing changes) iff `node` is dead or is the
@@ -163,6 +167,17 @@ class DpSlamFilter {
   PoseSink* sink_ = nullptr;
   DpSlamStats stats_{};
   ScanRays rays_{};
+  // The processed scans before the last (a ring, oldest at seed_head_ once full): a new
+  // segment's map starts with them (restart_segment()). Three, with the last, span the
+  // robot's last ~0.6 m or ~0.6 rad at the default update thresholds.
+  static constexpr std::uint32_t kSeedScans = 3U;
+  ScanRays seed_rays_[kSeedScans]{};
+  std::int64_t seed_stamp_us_[kSeedScans] = {};
+  Pose2 seed_pose_[kSeedScans] = {};         // its pose once committed (on every lineage)
+  bool seed_committed_[kSeedScans] = {};
+  std::uint32_t seed_head_ = 0U;
+  std::uint32_t seed_count_ = 0U;
+  std::int64_t rays_stamp_us_ = 0;  // stamp of the scan in rays_
 
   Particle* particles_ = nullptr;      // current generation
   Particle* next_ = nullptr;           // next generation (swapped)
