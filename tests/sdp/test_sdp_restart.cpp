@@ -10,6 +10,17 @@
 
 using namespace sdpslam;
 
+namespace {
+
+// Four particles, with room in the node pool for anchored segments.
+DpSlamOptions restart_options() {
+  DpSlamOptions o = test::sim_options(4);
+  o.extra_ancestry_nodes = 32U;
+  return o;
+}
+
+}  // namespace
+
 TEST_GROUP(SdpRestart){};
 
 TEST(SdpRestart, restart_before_the_first_scan_is_refused) {
@@ -20,8 +31,7 @@ TEST(SdpRestart, restart_before_the_first_scan_is_refused) {
 }
 
 TEST(SdpRestart, restart_anchors_the_old_nodes_and_starts_every_particle_at_one_pose) {
-  DpSlamOptions o = test::sim_options(4);
-  o.extra_ancestry_nodes = 32U;
+  const DpSlamOptions o = restart_options();
   test::FilterRig rig;
   CHECK_TRUE(rig.init(o, 3));
   const test::SimRun run = test::make_loop(1);
@@ -70,8 +80,7 @@ TEST(SdpRestart, restart_anchors_the_old_nodes_and_starts_every_particle_at_one_
 }
 
 TEST(SdpRestart, a_new_segment_starts_with_the_last_scans_placed_as_the_best_lineage_placed_them) {
-  DpSlamOptions o = test::sim_options(4);
-  o.extra_ancestry_nodes = 32U;
+  const DpSlamOptions o = restart_options();
   test::FilterRig rig;
   CHECK_TRUE(rig.init(o, 3));
   const test::SimRun run = test::make_loop(1);
@@ -149,8 +158,7 @@ TEST(SdpRestart, a_new_segment_starts_with_the_last_scans_placed_as_the_best_lin
 }
 
 TEST(SdpRestart, release_refuses_current_particles_and_frees_anchored_observations) {
-  DpSlamOptions o = test::sim_options(4);
-  o.extra_ancestry_nodes = 32U;
+  const DpSlamOptions o = restart_options();
   test::FilterRig rig;
   CHECK_TRUE(rig.init(o, 5));
   const test::SimRun run = test::make_loop(1);
