@@ -392,11 +392,8 @@ int profile_handler(void* user, const char* section, const char* name, const cha
 }  // namespace
 
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
-  std::FILE* f = std::fopen(path.c_str(), "r");
-  if (f == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
+  std::FILE* f = slam::open_config_file(path, error);
+  if (f == nullptr) return false;
   // The [slam] profile (sdp mode) is where the options start: the file's keys go on top of
   // it wherever they appear in the file.
   (void)ini_parse_file(f, profile_handler, config);

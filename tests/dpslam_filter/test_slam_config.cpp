@@ -150,3 +150,18 @@ TEST(RunOffline, unreadable_log_is_bad_input) {
         slam::RunStatus::kBadInput);
   CHECK(!error.empty());
 }
+
+// fopen accepts a directory on Linux and reading it looks like an empty file: the run
+// would go on with the built-in defaults as if the file had been read.
+TEST(SlamConfig, a_directory_is_refused_as_a_config_file_and_dev_null_reads_as_empty) {
+  const std::string dir = sdpslam::test::make_temp_dir("slam_config_dir");
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(dir, &c, &error));
+  STRCMP_EQUAL((dir + ": is a directory, not a configuration file").c_str(), error.c_str());
+  error.clear();
+  std::FILE* f = slam::open_config_file(dir, &error);
+  CHECK(f == nullptr);
+  STRCMP_EQUAL((dir + ": is a directory, not a configuration file").c_str(), error.c_str());
+  CHECK_TRUE_TEXT(slam::load_config_ini("/dev/null", &c, &error), error.c_str());
+}

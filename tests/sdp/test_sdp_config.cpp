@@ -199,3 +199,11 @@ TEST(SdpConfig, enumerated_keys_take_their_names) {
   CHECK(slam::apply_sdp_key(&o, "elite_fraction", "abc", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "nothing", "1", &why) == slam::SdpKeyResult::kUnknown);
 }
+
+TEST(SdpConfig, a_directory_is_refused_as_a_config_file) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_config_dir");
+  SdpOptions o;
+  std::string error;
+  CHECK_FALSE(slam::load_sdp_ini(dir, &o, &error));
+  STRCMP_EQUAL((dir + ": is a directory, not a configuration file").c_str(), error.c_str());
+}

@@ -174,6 +174,15 @@ TEST(SdpslamdConfig, missing_file_is_reported) {
   CHECK(error.find("/nonexistent/sdpslamd.ini: cannot open") == 0);
 }
 
+// `sdpslamd --config /etc --check-config` used to answer "ok" and run the built-in defaults.
+TEST(SdpslamdConfig, a_directory_is_refused_as_a_config_file) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdpslamd_config_dir");
+  DaemonConfig c;
+  std::string error;
+  CHECK_FALSE(load_daemon_config(dir, &c, &error));
+  STRCMP_EQUAL((dir + ": is a directory, not a configuration file").c_str(), error.c_str());
+}
+
 TEST(SdpslamdConfig, shipped_example_and_the_built_in_default_select_sdp) {
   DaemonConfig c;
   CHECK(c.mode == sdpslam::daemon::SlamMode::kSdp);

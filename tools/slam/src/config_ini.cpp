@@ -2,6 +2,8 @@
 
 #include <ini.h>
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -190,10 +192,31 @@ ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, con
   return ConfigKeyResult::kApplied;
 }
 
-bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
+std::FILE* open_config_file(const std::string& path, std::string* error) {
   std::FILE* f = std::fopen(path.c_str(), "r");
   if (f == nullptr) {
-    if (error != nullptr) *error = path + ": cannot open: " + std::strerror(errno);
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return nullptr;
+  }
+  struct stat st {};
+  if (::fstat(::fileno(f), &st) != 0) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    std::fclose(f);
+    return nullptr;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    *error = path + ": is a directory, not a configuration file";
+    std::fclose(f);
+    return nullptr;
+  }
+  return f;
+}
+
+bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
+  std::string why;
+  std::FILE* f = open_config_file(path, &why);
+  if (f == nullptr) {
+    if (error != nullptr) *error = why;
     return false;
   }
   ParseState st{config, path, {}, f, 0};

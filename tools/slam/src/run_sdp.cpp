@@ -248,11 +248,8 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
 }
 
 bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error) {
-  FILE* f = std::fopen(path.c_str(), "r");
-  if (f == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
+  std::FILE* f = open_config_file(path, error);
+  if (f == nullptr) return false;
   IniState st{options, {}};
   const int rc = ini_parse_file(f, sdp_handler, &st);
   std::fclose(f);

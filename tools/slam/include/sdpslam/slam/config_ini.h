@@ -2,6 +2,7 @@
 // INI configuration of the bottom-level filter (tools/slam/default.ini documents every
 // key). Sections and keys mirror DpSlamOptions; `[log] default_range_max_m` sets the
 // log reader's no-return threshold for formats that do not carry one.
+#include <cstdio>
 #include <string>
 
 #include "sdpslam/core/dpslam_options.h"
@@ -20,6 +21,12 @@ struct SlamConfig {
 // `error` is then "file:line: reason". An [sdp] section (SDP-SLAM's top level, read by
 // load_sdp_ini in run_sdp.h) is skipped.
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
+
+// Opens a configuration file for reading, for every INI reader (this file's, run_sdp.h's
+// and sdpslamd's). Null, with `error` = "path: reason", iff it cannot be opened or is a
+// directory (fopen accepts one on Linux, and reading it looks like an empty file: the
+// built-in defaults would run unannounced). Files, pipes and /dev/null are accepted.
+std::FILE* open_config_file(const std::string& path, std::string* error);
 
 // One `key = value` of the sections above ([filter] [motion] [observation] [map]
 // [capacity] [log]), for programs whose own INI files embed these sections (sdpslamd).
