@@ -6,7 +6,8 @@
 //   1. propagate: every particle samples a pose from the odometry motion model
 //      (motion_model.h) around its previous pose; or, with the improved proposal
 //      (DpSlamOptions::proposal), around a scan match against its own map view, held to
-//      the odometry's travel where the map is silent (scan_matcher.h), falling back to the odometry model where the match fails;
+//      the odometry's travel where the map is silent (scan_matcher.h), falling back to
+//      the odometry model where the match fails;
 //   2. weight: log p(scan | pose, particle's map) through the DP map (beam_model.h);
 //   3. resample (low variance) iff N_eff < resample_neff_ratio · N (resampling.h);
 //   4. map update: every particle that survives resampling writes the scan into its own
