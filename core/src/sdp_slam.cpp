@@ -5,6 +5,7 @@
 #include <cstring>
 #include <new>
 
+#include "sdpslam/core/box2.h"
 #include "sdpslam/core/det_math.h"
 
 namespace sdpslam {
@@ -20,26 +21,16 @@ std::uint32_t coarse_side_cells(const DpSlamOptions& b, const SdpOptions& s) {
 }
 std::uint32_t ring_capacity_for(const SdpOptions& s) { return (s.max_levels + 2U) * (s.max_segment_scans + 2U); }
 // Wide loop search grid: a skeleton patch of coarse cells plus the reach of a kernel of
-// 1.5 cells (2 × (5 + 2) cells, correlative_matcher.cpp).
-std::uint32_t search_grid_side(std::size_t coarse_side) { return static_cast<std::uint32_t>(coarse_side) + 16U; }
-// The search works on obstacle points, which lie on the skeleton's coarse cells.
-double search_resolution_m(const DpSlamOptions& b, const SdpOptions& s) {
-  return b.map_resolution_m * static_cast<double>(s.skeleton_downsample);
+// 1.5 cells (2 × (5 + 2) cells, correlative_matcher.cpp); the search works on obstacle
+// points, which lie on the skeleton's coarse cells.
+LoopSearchGeometry search_geometry(const DpSlamOptions& b, const SdpOptions& s) {
+  LoopSearchGeometry g;
+  g.resolution_m = b.map_resolution_m * static_cast<double>(s.skeleton_downsample);
+  g.grid_side = coarse_side_cells(b, s) + 16U;
+  return g;
 }
-constexpr std::uint32_t kSearchCoarseCells = 4U;
-std::uint32_t search_steps(const DpSlamOptions& b, const SdpOptions& s) {
-  return CorrelativeMatcher::steps_for(s.loop_search_window_m, search_resolution_m(b, s), kSearchCoarseCells);
-}
-
 // The loop-closure graph holds every permanent submap still kept and every live level.
-FrameGraphOptions frame_graph_options(const SdpOptions& s) {
-  FrameGraphOptions o;
-  o.max_nodes = s.max_permanent_submaps + s.max_levels;
-  o.max_loops = s.max_loop_constraints;
-  o.iterations = s.graph_iterations;
-  o.robust_chi = s.loop_robust_chi;
-  return o;
-}
+std::uint32_t graph_nodes(const SdpOptions& s) { return s.max_permanent_submaps + s.max_levels; }
 
 SegmentGraphOptions graph_options(const SdpOptions& s, std::uint32_t n) {
   SegmentGraphOptions g;
@@ -50,21 +41,6 @@ SegmentGraphOptions graph_options(const SdpOptions& s, std::uint32_t n) {
   return g;
 }
 
-void box_init(double b[4]) {
-  b[0] = 1.0e300;
-  b[1] = 1.0e300;
-  b[2] = -1.0e300;
-  b[3] = -1.0e300;
-}
-void box_add(double b[4], double x, double y) {
-  if (x < b[0]) b[0] = x;
-  if (y < b[1]) b[1] = y;
-  if (x > b[2]) b[2] = x;
-  if (y > b[3]) b[3] = y;
-}
-bool box_valid(const double b[4]) { return b[0] <= b[2] && b[1] <= b[3]; }
-
-// Axis-aligned bounds, in the parent frame, of box `b` given in `frame`.
 // How far apart two placements of a submap put its box's corners (m): the largest
 // corner distance. An invalid (empty) box counts its frame origin only.
 double frame_offset_m(const Pose2& a, const Pose2& b, const double box[4]) {
@@ -84,20 +60,6 @@ double frame_offset_m(const Pose2& a, const Pose2& b, const double box[4]) {
   return worst;
 }
 
-void box_transform(const Pose2& frame, const double b[4], double out[4]) {
-  box_init(out);
-  const double xs[2] = {b[0], b[2]};
-  const double ys[2] = {b[1], b[3]};
-  for (double x : xs) {
-    for (double y : ys) {
-      double gx = 0.0;
-      double gy = 0.0;
-      frame.transform_point(x, y, gx, gy);
-      box_add(out, gx, gy);
-    }
-  }
-}
-
 }  // namespace
 
 double SdpStats::error_std_m() const {
@@ -108,14 +70,7 @@ double SdpStats::error_std_m() const {
   return v > 0.0 ? det::sqrt(v) : 0.0;
 }
 
-double SdpSlam::box_overlap_m2(const double a[4], const double b[4]) {
-  const double x0 = a[0] > b[0] ? a[0] : b[0];
-  const double y0 = a[1] > b[1] ? a[1] : b[1];
-  const double x1 = a[2] < b[2] ? a[2] : b[2];
-  const double y1 = a[3] < b[3] ? a[3] : b[3];
-  if (!(x1 > x0) || !(y1 > y0)) return 0.0;
-  return (x1 - x0) * (y1 - y0);
-}
+double SdpSlam::box_overlap_m2(const double a[4], const double b[4]) { return sdpslam::box_overlap_m2(a, b); }
 
 DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp) {
   DpSlamOptions b = bottom;
@@ -162,14 +117,9 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
   total += Arena::bytes_for<StampedPose>(ring_capacity_for(s)) + Arena::bytes_for<IcpMemo>(kIcpMemoSlots) + Arena::bytes_for<NodeId>(n);
   if (s.loop_closure) {
-    total += Arena::bytes_for<LoopRecord>(s.max_loop_constraints) + FrameGraph::required_bytes(frame_graph_options(s));
+    total += LoopClosure::required_bytes(s, graph_nodes(s), search_geometry(b, s));
     total += Arena::bytes_for<CellPoint>((L * n + s.max_permanent_submaps) * std::size_t{s.loop_points}) +
              2U * Arena::bytes_for<Point2>(s.loop_points);
-    if (s.loop_search_window_m > 0.0) {
-      total += CorrelativeMatcher::required_bytes(search_grid_side(cs), s.loop_points, search_steps(b, s)) +
-               2U * Arena::bytes_for<Point2>(s.loop_points) +
-               Arena::bytes_for<std::uint32_t>(std::size_t{s.max_permanent_submaps} + L);
-    }
   }
   total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
   return total + kSlack;
@@ -252,33 +202,17 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   ring_capacity_ = ring_capacity_for(s);
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
   memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
-  loop_count_ = 0U;
-  search_level_ = 0U;
-  search_count_ = 0U;
-  search_cursor_ = 0U;
   if (s.loop_closure) {
-    loops_ = arena.allocate_array<LoopRecord>(s.max_loop_constraints);
     live_obst_ = arena.allocate_array<CellPoint>(std::size_t{L} * n_bottom_ * s.loop_points);
     perm_obst_ = arena.allocate_array<CellPoint>(std::size_t{s.max_permanent_submaps} * s.loop_points);
     obst_a_ = arena.allocate_array<Point2>(s.loop_points);
     obst_b_ = arena.allocate_array<Point2>(s.loop_points);
-    if (s.loop_search_window_m > 0.0) {
-      search_a_ = arena.allocate_array<Point2>(s.loop_points);
-      search_b_ = arena.allocate_array<Point2>(s.loop_points);
-      hops_ = arena.allocate_array<std::uint32_t>(std::size_t{s.max_permanent_submaps} + L);
-      if (search_a_ == nullptr || search_b_ == nullptr || hops_ == nullptr) {
-        std::snprintf(why_, sizeof why_, "arena exhausted (loop search)");
-        return false;
-      }
-    }
     if (b.map_width_m / b.map_resolution_m > 32767.0 || b.map_height_m / b.map_resolution_m > 32767.0) {
       std::snprintf(why_, sizeof why_, "sdp.loop_closure: the map grid is wider than 32767 cells");
       return false;
     }
-    if (loops_ == nullptr || live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr ||
-        obst_b_ == nullptr || !frame_graph_.init(frame_graph_options(s), arena) ||
-        (s.loop_search_window_m > 0.0 &&
-         !matcher_.init(search_grid_side(coarse_side_), s.loop_points, search_steps(b, s), arena))) {
+    if (live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr || obst_b_ == nullptr ||
+        !loop_closure_.init(s, graph_nodes(s), search_geometry(b, s), icp_, this, &stats_, arena)) {
       std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");
       return false;
     }
@@ -444,7 +378,7 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
     }
     if (eval_cursor_ >= n_top_) end_round(scan.stamp_us, true);
   }
-  if (options_.loop_closure && options_.loop_search_window_m > 0.0 && !work_pending && started_) loop_search_step();
+  if (options_.loop_closure && options_.loop_search_window_m > 0.0 && !work_pending && started_) loop_closure_.search_step();
   result.pose = current_frame_.compose(result.bottom.pose);
   return result;
 }
@@ -1021,32 +955,21 @@ void SdpSlam::evaluate(std::uint32_t p) {
           // Refine on obstacle points, starting from the skeleton match.
           const CellPoint* to = nullptr;
           std::uint32_t tn = 0U;
-          LoopRecord lr;
+          std::uint32_t older = older_level;
           if (c.older >= 0) {
             to = live_obstacles(older_level, chain_[c.older]);
             tn = submap(older_level, chain_[c.older]).obstacle_count;
-            lr.older_level = older_level;
           } else {
             const Permanent& pm = perm_[-c.older - 1];
             to = perm_obstacles(static_cast<std::uint32_t>(-c.older - 1));
             tn = pm.obstacle_count;
-            lr.older_level = pm.level;
+            older = pm.level;
           }
-          lr.newer_level = first + c.newer;
           const std::uint32_t sn_count = sn.obstacle_count;
           if (tn >= options_.loop_min_pairs && sn_count >= options_.loop_min_pairs) {
             unpack(to, tn, obst_a_);
             unpack(live_obstacles(first + c.newer, chain_[c.newer]), sn_count, obst_b_);
-            const Icp2dResult f = icp_->match(obst_a_, tn, obst_b_, sn_count, r.transform, loop_icp_options());
-            ++stats_.loop_refinements;
-            const Pose2 moved = between(guess, f.transform);
-            if (f.usable() && f.mean_nn_error_m <= options_.loop_max_error_m && f.matched_pairs >= options_.loop_min_pairs &&
-                det::sqrt(moved.x_m * moved.x_m + moved.y_m * moved.y_m) <= options_.loop_max_correction_m) {
-              lr.z = f.transform;
-              lr.error_m = f.mean_nn_error_m;
-              lr.info = loop_information(obst_a_, tn, obst_b_, sn_count, f.transform);
-              record_loop(lr);
-            }
+            loop_closure_.refine(older, obst_a_, tn, first + c.newer, obst_b_, sn_count, guess, r.transform);
           }
         }
         if (options_.icp_correction_weight > 0.0) {
@@ -1197,82 +1120,13 @@ bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
   return true;
 }
 
-// A record can never join the graph again once one of its levels was forgotten.
-bool SdpSlam::loop_record_dead(const LoopRecord& r) const {
-  std::uint32_t index = 0U;
-  return !graph_index(r.older_level, &index) || !graph_index(r.newer_level, &index);
-}
-
-Icp2dOptions SdpSlam::loop_icp_options() const {
-  Icp2dOptions fine = options_.icp;
-  fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
-  fine.min_pairs = options_.loop_min_pairs;
-  return fine;
-}
-
-// The pairing's direction information M (icp2d.h) weights the constraint per direction
-// (FrameInfo::from_directions): a corridor match keeps its across-corridor information.
-FrameInfo SdpSlam::loop_information(const Point2* target, std::uint32_t target_count, const Point2* source,
-                                    std::uint32_t source_count, const Pose2& z) {
-  const FrameInfo iso = FrameInfo::from_sigma(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad);
-  if (!(options_.loop_normal_radius_m > 0.0)) return iso;
-  Icp2dInformation m;
-  if (!icp_->direction_information(target, target_count, source, source_count, z, loop_icp_options(),
-                                   options_.loop_normal_radius_m, &m)) {
-    ++stats_.loop_information_unmeasured;
-    return iso;
-  }
-  const FrameInfo info = FrameInfo::from_directions(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad, m.xx, m.xy,
-                                                    m.yy, options_.loop_weak_direction_floor, z.heading_rad);
-  if (!info.valid()) {
-    ++stats_.loop_information_unmeasured;
-    return iso;
-  }
-  // Weak: some direction keeps less than half of the isotropic information.
-  if (info.xx * info.yy - info.xy * info.xy < 0.5 * iso.xx * iso.yy) ++stats_.loop_constraints_weak_direction;
-  return info;
-}
-
-// One record per pair of levels (the lowest residual wins). When the store is full a
-// dead record makes room, else the worst record if the new one is better.
-void SdpSlam::record_loop(const LoopRecord& r) {
-  std::uint32_t worst = loop_count_;
-  std::uint32_t dead = loop_count_;
-  for (std::uint32_t k = 0; k < loop_count_; ++k) {
-    LoopRecord& q = loops_[k];
-    if (q.older_level == r.older_level && q.newer_level == r.newer_level) {
-      if (r.error_m < q.error_m) {
-        const bool searched = q.searched || r.searched;
-        q = r;
-        q.searched = searched;
-      }
-      return;
-    }
-    if (dead == loop_count_ && loop_count_ == options_.max_loop_constraints && loop_record_dead(q)) dead = k;
-    if (worst == loop_count_ || q.error_m > loops_[worst].error_m) worst = k;
-  }
-  ++stats_.loop_records_added;
-  if (loop_count_ < options_.max_loop_constraints) {
-    loops_[loop_count_++] = r;
-  } else if (dead < loop_count_) {
-    loops_[dead] = r;
-  } else if (worst < loop_count_ && r.error_m < loops_[worst].error_m) {
-    loops_[worst] = r;
-    ++stats_.loop_records_dropped;
-  } else {
-    ++stats_.loop_records_dropped;
-  }
-  stats_.loop_records = loop_count_;
-}
-
 // The best combination's frames as a pose graph (frame_graph.h): permanent submaps held
 // (oldest fixed), then the chosen live submaps (frames_ on entry: the composed chain),
 // chain constraints T between consecutive ones, loop constraints between any two.
 void SdpSlam::adjust_frames() {
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
-  FrameGraph& g = frame_graph_;
-  g.clear();
+  FrameGraph& g = loop_closure_.begin_adjustment();
   const FrameInfo seg = FrameInfo::from_sigma(options_.segment_sigma_xy_m, options_.segment_sigma_theta_rad);
   bool ok = true;
   for (std::uint32_t k = 0; k < perm_count_; ++k) {
@@ -1292,25 +1146,7 @@ void SdpSlam::adjust_frames() {
     ++stats_.frame_graph_refused;
     return;
   }
-  std::uint32_t used = 0U;
-  for (std::uint32_t k = 0; k < loop_count_; ++k) {
-    const LoopRecord& r = loops_[k];
-    std::uint32_t a = 0U, b = 0U;
-    if (!graph_index(r.older_level, &a) || !graph_index(r.newer_level, &b)) continue;
-    // The search's constraints were verified before they were recorded (loop_search_continue);
-    // the top level's ICP constraints were not, and keep their kernel.
-    const double chi = r.searched ? FrameGraph::kNoKernel : options_.loop_robust_chi;
-    if (g.add_loop(a, b, r.z, r.info, chi)) {
-      ++used;
-    } else {
-      ++stats_.frame_graph_refused;
-    }
-  }
-  stats_.loop_constraints_used = used;
-  if (used == 0U) return;  // the chain alone is already consistent
-  g.optimise();
-  ++stats_.frame_adjustments;
-  stats_.loop_downweighted = g.stats().last_downweighted;
+  if (!loop_closure_.finish_adjustment()) return;  // the chain alone is already consistent
   double offset = 0.0;
   for (std::uint32_t k = 0; k < perm_count_; ++k) {
     Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
@@ -1325,7 +1161,7 @@ void SdpSlam::adjust_frames() {
   for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(perm_count_ + i);
 }
 
-// ---- wide loop search (beyond the paper; correlative_matcher.h) -----------------------
+// ---- the submaps as loop closure sees them (loop_closure.h) ----------------------------
 
 bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
                               double box[4]) const {
@@ -1350,267 +1186,21 @@ bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std
   return true;
 }
 
-// A search in progress continues; else the next candidate of the level being searched
-// starts, else the next level's candidates are collected (levels in order, each once,
-// as soon as its skeletons exist).
-void SdpSlam::loop_search_step() {
-  if (matcher_.active()) {
-    loop_search_continue();
-    return;
-  }
-  if (search_cursor_ >= search_count_) {
-    const std::uint32_t first = graph_.first_live_level();
-    if (search_level_ < first) search_level_ = first;
-    if (search_level_ >= graph_.level_end()) return;
-    search_newer_ = search_level_++;
-    loop_search_collect(search_newer_);
-    if (search_count_ == 0U) return;
-  }
-  loop_search_pair(search_older_[search_cursor_++], search_newer_);
+std::uint32_t SdpSlam::first_held_level() const {
+  return perm_count_ > 0U ? perm_[perm_head_].level : graph_.first_live_level();
 }
 
-// Older levels (permanent or live, not adjacent, not already constrained to it) whose
-// boxes in the best combination overlap the newer's box grown by the search window;
-// the loop_search_candidates largest overlaps.
-void SdpSlam::loop_search_collect(std::uint32_t newer) {
-  search_count_ = 0U;
-  search_cursor_ = 0U;
-  search_held_count_ = 0U;  // a held peak waits for its own level's other pairs only
-  const CellPoint* pts = nullptr;
+bool SdpSlam::placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const {
+  const CellPoint* points = nullptr;
+  return level_obstacles(level, &points, obstacle_count, frame, box);
+}
+
+void SdpSlam::obstacles(std::uint32_t level, Point2* out) const {
+  const CellPoint* points = nullptr;
   std::uint32_t n = 0U;
   Pose2 frame;
   double box[4];
-  if (!level_obstacles(newer, &pts, &n, &frame, box) || n < options_.loop_min_pairs || !box_valid(box)) return;
-  double nb[4];
-  box_transform(frame, box, nb);
-  const double w = options_.loop_search_window_m;
-  nb[0] -= w;
-  nb[1] -= w;
-  nb[2] += w;
-  nb[3] += w;
-  double area[SdpOptions::kMaxLoopSearchCandidates];
-  const std::uint32_t kmax = options_.loop_search_candidates;
-  auto consider = [&](std::uint32_t older) {
-    const CellPoint* op = nullptr;
-    std::uint32_t on = 0U;
-    Pose2 of;
-    double ob[4];
-    if (!level_obstacles(older, &op, &on, &of, ob) || on < options_.loop_min_pairs || !box_valid(ob)) return;
-    for (std::uint32_t k = 0; k < loop_count_; ++k) {
-      if (loops_[k].older_level == older && loops_[k].newer_level == newer) return;
-    }
-    double gb[4];
-    box_transform(of, ob, gb);
-    const double a = box_overlap_m2(gb, nb);
-    if (a < options_.min_overlap_m2 || !(a > 0.0)) return;
-    std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
-    if (pos == kmax && !(a > area[kmax - 1U])) return;
-    if (pos == kmax) pos = kmax - 1U;
-    while (pos > 0U && area[pos - 1U] < a) {
-      area[pos] = area[pos - 1U];
-      search_older_[pos] = search_older_[pos - 1U];
-      --pos;
-    }
-    area[pos] = a;
-    search_older_[pos] = older;
-    if (search_count_ < kmax) ++search_count_;
-  };
-  for (std::uint32_t k = 0; k < perm_count_; ++k) {
-    const std::uint32_t lv = perm_[(perm_head_ + k) % options_.max_permanent_submaps].level;
-    if (lv + 2U <= newer) consider(lv);
-  }
-  for (std::uint32_t lv = graph_.first_live_level(); lv + 2U <= newer; ++lv) consider(lv);
-}
-
-void SdpSlam::loop_search_pair(std::uint32_t older, std::uint32_t newer) {
-  const CellPoint* tp = nullptr;
-  const CellPoint* sp = nullptr;
-  std::uint32_t tn = 0U;
-  std::uint32_t sn = 0U;
-  Pose2 tframe;
-  Pose2 sframe;
-  double tb[4];
-  double sb[4];
-  // Either level may have become permanent (or been forgotten) since it was collected.
-  if (!level_obstacles(older, &tp, &tn, &tframe, tb) || !level_obstacles(newer, &sp, &sn, &sframe, sb)) return;
-  ++stats_.loop_searches;
-  unpack(tp, tn, search_a_);
-  unpack(sp, sn, search_b_);
-  search_pair_older_ = older;
-  search_pair_newer_ = newer;
-  search_a_count_ = tn;
-  search_b_count_ = sn;
-  CorrelativeOptions co;
-  co.resolution_m = search_resolution_m(bottom_options_, options_);
-  co.coarse_cells = kSearchCoarseCells;
-  co.kernel_sigma_m = 1.5 * co.resolution_m;
-  co.window_xy_m = options_.loop_search_window_m;
-  co.window_theta_rad = options_.loop_search_window_rad;
-  co.min_score = options_.loop_search_confirm_score;  // loop_search_continue() holds those below min_score
-  co.max_ambiguity = options_.loop_search_max_ambiguity;
-  if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
-    ++stats_.loop_search_failed;
-    return;
-  }
-  loop_search_continue();
-}
-
-// The coarse pass within the per-scan budget; the fine pass, ICP and the verdict when
-// it is complete.
-void SdpSlam::loop_search_continue() {
-  const std::uint64_t cost = matcher_.heading_cost();
-  std::uint64_t h = cost > 0U ? options_.loop_search_reads_per_scan / cost : 1U;
-  if (h < 1U) h = 1U;
-  if (h > 0xFFFFFFFFULL) h = 0xFFFFFFFFULL;
-  if (!matcher_.advance(static_cast<std::uint32_t>(h))) return;
-  const CorrelativeResult c = matcher_.finish();
-  if (c.status == CorrelativeResult::Status::kWeak) {
-    ++stats_.loop_search_weak;
-    return;
-  }
-  if (c.status == CorrelativeResult::Status::kAmbiguous) {
-    ++stats_.loop_search_ambiguous;
-    return;
-  }
-  if (!c.found()) {
-    ++stats_.loop_search_failed;
-    return;
-  }
-  const Icp2dResult f =
-      icp_->match(search_a_, search_a_count_, search_b_, search_b_count_, c.transform, loop_icp_options());
-  ++stats_.loop_refinements;
-  // ICP only polishes the peak: it must stay within a coarse block of it.
-  const Pose2 polish = between(c.transform, f.transform);
-  const double reach = static_cast<double>(kSearchCoarseCells) * search_resolution_m(bottom_options_, options_);
-  if (!f.usable() || f.mean_nn_error_m > options_.loop_max_error_m || f.matched_pairs < options_.loop_min_pairs ||
-      polish.x_m * polish.x_m + polish.y_m * polish.y_m > reach * reach) {
-    ++stats_.loop_search_refuted;
-    return;
-  }
-  LoopRecord lr;
-  lr.older_level = search_pair_older_;
-  lr.newer_level = search_pair_newer_;
-  lr.z = f.transform;
-  lr.error_m = f.mean_nn_error_m;
-  lr.info = loop_information(search_a_, search_a_count_, search_b_, search_b_count_, f.transform);
-  lr.searched = true;
-  // Held peaks this one agrees with are corroborated by it (whether it is held or not).
-  bool agreed = false;
-  std::uint32_t kept = 0U;
-  for (std::uint32_t k = 0; k < search_held_count_; ++k) {
-    if (loops_agree(search_held_[k], lr)) {
-      ++stats_.loop_search_corroborated;
-      loop_search_accept(search_held_[k]);
-      agreed = true;
-    } else {
-      search_held_[kept++] = search_held_[k];
-    }
-  }
-  search_held_count_ = kept;
-  const bool far = options_.loop_search_drift_m > 0.0 && loop_moves_too_far(lr);
-  if (c.score < options_.loop_search_min_score || far) {
-    ++stats_.loop_search_held;
-    if (far) ++stats_.loop_search_far;
-    for (std::uint32_t k = 0; k < loop_count_ && !agreed; ++k) {
-      agreed = loops_[k].newer_level == lr.newer_level && loops_agree(loops_[k], lr);
-    }
-    if (!agreed) {
-      if (search_held_count_ < SdpOptions::kMaxLoopSearchCandidates) search_held_[search_held_count_++] = lr;
-      return;
-    }
-    ++stats_.loop_search_corroborated;
-  }
-  loop_search_accept(lr);
-}
-
-void SdpSlam::loop_search_accept(const LoopRecord& r) {
-  ++stats_.loop_search_closed;
-  record_loop(r);
-  if (!loop_record_dead(r)) update_best();  // the frames follow the new constraint now
-}
-
-// Two matches of the same newer submap against different older ones agree when they
-// place it alike in the best combination's frame (each older submap where the frames
-// put it now).
-bool SdpSlam::loops_agree(const LoopRecord& a, const LoopRecord& b) const {
-  if (a.newer_level != b.newer_level || a.older_level == b.older_level) return false;
-  const CellPoint* pts = nullptr;
-  std::uint32_t n = 0U;
-  Pose2 fa;
-  Pose2 fb;
-  double box[4];
-  if (!level_obstacles(a.older_level, &pts, &n, &fa, box) || !level_obstacles(b.older_level, &pts, &n, &fb, box)) {
-    return false;
-  }
-  const Pose2 d = between(fa.compose(a.z), fb.compose(b.z));
-  const double xy = options_.loop_search_confirm_xy_m;
-  const double th = normalize_angle_rad(d.heading_rad);
-  return d.x_m * d.x_m + d.y_m * d.y_m <= xy * xy && (th < 0.0 ? -th : th) <= options_.loop_search_confirm_rad;
-}
-
-// Whether r would move its newer submap (the centre of its box) farther from where the
-// best combination's frames put it now than the chain may have drifted between the two
-// levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
-bool SdpSlam::loop_moves_too_far(const LoopRecord& r) const {
-  const CellPoint* pts = nullptr;
-  std::uint32_t n = 0U;
-  Pose2 fo;
-  Pose2 fn;
-  double ob[4];
-  double nb[4];
-  if (!level_obstacles(r.older_level, &pts, &n, &fo, ob) || !level_obstacles(r.newer_level, &pts, &n, &fn, nb) ||
-      !box_valid(nb)) {
-    return false;
-  }
-  const Pose2 centre{0.5 * (nb[0] + nb[2]), 0.5 * (nb[1] + nb[3]), 0.0};
-  const Pose2 now = fn.compose(centre);
-  const Pose2 moved = fo.compose(r.z).compose(centre);
-  const double dx = moved.x_m - now.x_m;
-  const double dy = moved.y_m - now.y_m;
-  const double limit_m2 = options_.loop_search_drift_m * options_.loop_search_drift_m *
-                          static_cast<double>(level_hops(r.older_level, r.newer_level));
-  return dx * dx + dy * dy > limit_m2;
-}
-
-// The fewest steps between two levels over the frame graph's nodes: chain steps between
-// consecutive levels, one step across each loop record both of whose levels are held
-// (other than one of this same pair).
-// Bounded work: at most kHopPasses rounds of relaxation (more would only shorten a
-// path that already crosses that many loops); the level gap if either is not held.
-std::uint32_t SdpSlam::level_hops(std::uint32_t older_level, std::uint32_t newer_level) const {
-  constexpr std::uint32_t kHopPasses = 8U;
-  const std::uint32_t gap = newer_level > older_level ? newer_level - older_level : older_level - newer_level;
-  std::uint32_t a = 0U;
-  std::uint32_t b = 0U;
-  if (hops_ == nullptr || !graph_index(older_level, &a) || !graph_index(newer_level, &b)) return gap;
-  const std::uint32_t n = perm_count_ + graph_.live_level_count();
-  for (std::uint32_t i = 0; i < n; ++i) hops_[i] = i > a ? i - a : a - i;
-  for (std::uint32_t pass = 0; pass < kHopPasses; ++pass) {
-    bool changed = false;
-    for (std::uint32_t k = 0; k < loop_count_; ++k) {
-      const LoopRecord& r = loops_[k];
-      // A record of the same pair is a rival estimate of this very constraint, not a path.
-      if (r.older_level == older_level && r.newer_level == newer_level) continue;
-      std::uint32_t u = 0U;
-      std::uint32_t v = 0U;
-      if (!graph_index(r.older_level, &u) || !graph_index(r.newer_level, &v)) continue;
-      if (hops_[u] + 1U < hops_[v]) {
-        hops_[v] = hops_[u] + 1U;
-        changed = true;
-      } else if (hops_[v] + 1U < hops_[u]) {
-        hops_[u] = hops_[v] + 1U;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-    for (std::uint32_t i = 1; i < n; ++i) {
-      if (hops_[i - 1U] + 1U < hops_[i]) hops_[i] = hops_[i - 1U] + 1U;
-    }
-    for (std::uint32_t i = n - 1U; i > 0U; --i) {
-      if (hops_[i] + 1U < hops_[i - 1U]) hops_[i - 1U] = hops_[i] + 1U;
-    }
-  }
-  return hops_[b];
+  if (level_obstacles(level, &points, &n, &frame, box)) unpack(points, n, out);
 }
 
 }  // namespace sdpslam

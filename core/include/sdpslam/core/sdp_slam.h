@@ -55,30 +55,17 @@
 // (set_active(false) + prune frees their DP-map observations; counted), one submap per
 // call of process() so that no single scan pays for all of them.
 //
-// Loop closure (beyond the paper, SdpOptions::loop_closure): when the skeleton ICP of
-// two non-adjacent submaps succeeds, ICP on their obstacle points (wall cells that
-// border free space, kept per submap at anchorage) refines it; a refined match with a
-// small residual and a bounded correction is kept as a constraint between the two
-// LEVELS' frames (all submaps of a level share its frame: the bottom particles restarted
-// at one pose), one per pair of levels. A constraint is only as certain as its match in
-// each direction: the refined pairing's wall normals (Icp2d::direction_information)
-// give it little information along a corridor it could slide in
-// (FrameInfo::from_directions). After every ranking, the frames of the best
-// combination — the permanent submaps still held and the chosen live submaps — are
-// adjusted by a pose graph (frame_graph.h) whose chain constraints are the transforms T
-// of Fig. 3 (l) and whose loops are those constraints. Permanent frames and the PGS
-// anchor move with it, so later samples are placed from the corrected frames; the
-// permanent path sink is told every new frame, so the trajectory follows, and so does
-// the map: each permanent cell is drawn moved by its level's correction since the copy
-// (for_each_permanent_cell).
-// Wide loop search (SdpOptions::loop_search_window_m > 0): ICP only sees loops the chain
-// already closed to within decimetres, so once per level the chosen submap is also
-// searched against the older submaps it may revisit, over metres and tenths of a
-// radian (correlative_matcher.h); an unambiguous peak that obstacle ICP confirms, and
-// that either stays within the chain's drift or is corroborated by a second older
-// submap, is verified: it becomes a constraint without a robust kernel (a kernel would
-// keep a true loop of metres only partly closed) and the frames are adjusted at once. The
-// search runs in slices (loop_search_reads_per_scan grid reads per call of process()).
+// Loop closure (beyond the paper, SdpOptions::loop_closure; loop_closure.h): every
+// skeleton ICP match of two non-adjacent submaps is handed to LoopClosure::refine, which
+// keeps constraints between the two levels' frames; the wide loop search runs a slice
+// per call of process(). After every ranking, the frames of the best combination — the
+// permanent submaps still held and the chosen live submaps, chained by the transforms T
+// of Fig. 3 (l) — are adjusted to those constraints (adjust_frames()). Permanent frames
+// and the PGS anchor move with it, so later samples are placed from the corrected
+// frames; the permanent path sink is told every new frame, so the trajectory follows,
+// and so does the map: each permanent cell is drawn moved by its level's correction
+// since the copy (for_each_permanent_cell). SdpSlam shows LoopClosure its submaps
+// through LoopSubmaps (the best combination's choice of each held level).
 //
 // Worst-scan time: anchorage work is spread over calls of process() within
 // work_cells_per_scan cells each (plus at most one row): first the copy of a permanent
@@ -97,10 +84,10 @@
 #include <cstdint>
 
 #include "sdpslam/core/dpslam_filter.h"
-#include "sdpslam/core/correlative_matcher.h"
 #include "sdpslam/core/frame_graph.h"
 #include "sdpslam/core/free_space_skeleton.h"
 #include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/loop_closure.h"
 #include "sdpslam/core/permanent_map.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/segment_graph.h"
@@ -116,7 +103,8 @@ struct SdpStepResult {
   std::uint32_t work_cells = 0U;   // map cells read by anchorage work during this call
 };
 
-struct SdpStats {
+// Loop closure's counts (loop_closure.h) are part of it.
+struct SdpStats : LoopClosureStats {
   std::uint64_t segments = 0U;            // segmentations done (levels added)
   std::uint64_t restart_refused = 0U;     // segmentation postponed: no room to restart
   std::uint64_t window_segmentations = 0U;  // segments ended at the edge of their DP-map square
@@ -145,25 +133,6 @@ struct SdpStats {
   std::uint64_t icp_matches = 0U;
   std::uint64_t icp_failures = 0U;          // overlapping boxes, too few correspondences
   std::uint64_t icp_memo_hits = 0U;         // pair results reused instead of recomputed
-  std::uint64_t loop_records = 0U;          // loop constraints held now
-  std::uint64_t loop_refinements = 0U;      // obstacle-point ICP runs
-  std::uint64_t loop_records_added = 0U;    // ICP matches kept as loop constraints
-  std::uint64_t loop_records_dropped = 0U;  // kept matches that found no room (store full)
-  std::uint64_t loop_constraints_used = 0U; // in the last adjustment
-  std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
-  std::uint64_t loop_constraints_weak_direction = 0U;  // loop matches weak along a direction (corridors)
-  std::uint64_t loop_information_unmeasured = 0U;      // loop matches whose direction information failed
-  std::uint64_t frame_adjustments = 0U;     // pose-graph solves
-  std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
-  std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
-  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_confirm_score
-  std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
-  std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
-  std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
-  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints (held ones included)
-  std::uint64_t loop_search_held = 0U;      // ... held for a second match (scoring confirm_score .. min_score, or far)
-  std::uint64_t loop_search_far = 0U;       // held ones that would move their submap beyond loop_search_drift_m × √hops
-  std::uint64_t loop_search_corroborated = 0U;  // held ones another pair agreed with (constraints now)
   std::uint64_t pose_ring_dropped = 0U;     // committed poses lost (trajectory gap)
   std::uint32_t pose_ring_peak = 0U;
   std::uint32_t max_live_levels = 0U;
@@ -196,7 +165,7 @@ class SdpPathSink {
   ~SdpPathSink() = default;
 };
 
-class SdpSlam {
+class SdpSlam final : private LoopSubmaps {
  public:
   SdpSlam() = default;
   SdpSlam(const SdpSlam&) = delete;
@@ -296,16 +265,6 @@ class SdpSlam {
   struct CellPoint {
     std::uint16_t ix = 0U;
     std::uint16_t iy = 0U;
-  };
-  // A loop constraint: the pose of the newer level's frame in the older one's, as ICP on
-  // obstacle points found it, with the residual it left.
-  struct LoopRecord {
-    std::uint32_t older_level = 0U;
-    std::uint32_t newer_level = 0U;
-    Pose2 z;
-    FrameInfo info;  // in the frame of z's error (loop_information())
-    double error_m = 0.0;
-    bool searched = false;  // found by the wide loop search (else by the top level's ICP)
   };
   // Memo of ICP results: many samples share a pair of submaps placed identically (elite
   // copies, common chains), and ICP is deterministic, so the same inputs give the same
@@ -411,29 +370,20 @@ class SdpSlam {
   bool permanent_slot(std::uint32_t level, std::uint32_t* pi) const;
   // Index of a level's frame in the best combination's frame graph, if it is part of it.
   bool graph_index(std::uint32_t level, std::uint32_t* index) const;
-  bool loop_record_dead(const LoopRecord& r) const;
-  void record_loop(const LoopRecord& r);
-  // The obstacle-point ICP options of loop refinements.
-  Icp2dOptions loop_icp_options() const;
-  // The information of loop constraint z (source = newer submap's obstacle points,
-  // target = older's) from the direction information of that pairing
-  // (SdpOptions::loop_normal_radius_m), in the frame of z's error (frame_graph.h).
-  FrameInfo loop_information(const Point2* target, std::uint32_t target_count, const Point2* source,
-                             std::uint32_t source_count, const Pose2& z);
   void adjust_frames();
-  // Wide loop search (loop_search_window_m > 0): one pair of submaps per call.
-  void loop_search_step();
-  void loop_search_collect(std::uint32_t newer_level);
-  void loop_search_pair(std::uint32_t older_level, std::uint32_t newer_level);
-  void loop_search_continue();
-  bool loops_agree(const LoopRecord& a, const LoopRecord& b) const;
-  bool loop_moves_too_far(const LoopRecord& r) const;
-  std::uint32_t level_hops(std::uint32_t older_level, std::uint32_t newer_level) const;
-  void loop_search_accept(const LoopRecord& r);
   // Obstacle points and global frame of a level in the best combination (permanent or
   // live); false if the level is no longer held.
   bool level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
                        double box[4]) const;
+  // LoopSubmaps: the best combination's submaps, as loop closure sees them.
+  bool node_index(std::uint32_t level, std::uint32_t* index) const override { return graph_index(level, index); }
+  std::uint32_t node_count() const override { return perm_count_ + graph_.live_level_count(); }
+  std::uint32_t first_held_level() const override;
+  std::uint32_t first_live_level() const override { return graph_.first_live_level(); }
+  std::uint32_t level_end() const override { return graph_.level_end(); }
+  bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const override;
+  void obstacles(std::uint32_t level, Point2* out) const override;
+  void on_verified_loop() override { update_best(); }
 
   SdpOptions options_{};
   DpSlamOptions bottom_options_{};
@@ -476,29 +426,11 @@ class SdpSlam {
   CellState* coarse_ = nullptr;
   std::uint32_t coarse_side_ = 0U;
   IcpMemo* memo_ = nullptr;  // kIcpMemoSlots
-  LoopRecord* loops_ = nullptr;  // max_loop_constraints
   CellPoint* live_obst_ = nullptr;  // max_levels × N × loop_points
   CellPoint* perm_obst_ = nullptr;  // max_permanent_submaps × loop_points
   Point2* obst_a_ = nullptr;        // loop_points (scratch)
   Point2* obst_b_ = nullptr;
-  std::uint32_t loop_count_ = 0U;
-  FrameGraph frame_graph_;
-  CorrelativeMatcher matcher_;
-  std::uint32_t search_level_ = 0U;     // next level whose submap is searched for loops
-  std::uint32_t search_newer_ = 0U;     // level being searched
-  std::uint32_t search_older_[SdpOptions::kMaxLoopSearchCandidates] = {};
-  std::uint32_t search_count_ = 0U;
-  std::uint32_t search_cursor_ = 0U;
-  Point2* search_a_ = nullptr;  // loop_points: the pair being searched (older, newer)
-  Point2* search_b_ = nullptr;
-  std::uint32_t search_a_count_ = 0U;
-  std::uint32_t search_b_count_ = 0U;
-  std::uint32_t search_pair_older_ = 0U;
-  std::uint32_t search_pair_newer_ = 0U;
-  // Weak peaks of the level being searched, waiting for a second pair to agree.
-  LoopRecord search_held_[SdpOptions::kMaxLoopSearchCandidates] = {};
-  std::uint32_t search_held_count_ = 0U;
-  std::uint32_t* hops_ = nullptr;  // max_permanent_submaps + max_levels (level_hops() scratch)
+  LoopClosure loop_closure_;
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N

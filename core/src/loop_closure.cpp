@@ -1,0 +1,438 @@
+#include "sdpslam/core/loop_closure.h"
+
+#include "sdpslam/core/box2.h"
+#include "sdpslam/core/det_math.h"
+
+namespace sdpslam {
+namespace {
+
+// The search's coarse pass works in blocks of this many grid cells.
+constexpr std::uint32_t kSearchCoarseCells = 4U;
+
+std::uint32_t search_steps(const SdpOptions& s, const LoopSearchGeometry& g) {
+  return CorrelativeMatcher::steps_for(s.loop_search_window_m, g.resolution_m, kSearchCoarseCells);
+}
+
+FrameGraphOptions graph_options(const SdpOptions& s, std::uint32_t max_nodes) {
+  FrameGraphOptions o;
+  o.max_nodes = max_nodes;
+  o.max_loops = s.max_loop_constraints;
+  o.iterations = s.graph_iterations;
+  o.robust_chi = s.loop_robust_chi;
+  return o;
+}
+
+}  // namespace
+
+std::size_t LoopClosure::required_bytes(const SdpOptions& s, std::uint32_t max_nodes, const LoopSearchGeometry& g) {
+  if (!s.loop_closure) return 0U;
+  std::size_t total = Arena::bytes_for<Record>(s.max_loop_constraints) + FrameGraph::required_bytes(graph_options(s, max_nodes));
+  if (s.loop_search_window_m > 0.0) {
+    total += CorrelativeMatcher::required_bytes(g.grid_side, s.loop_points, search_steps(s, g)) +
+             2U * Arena::bytes_for<Point2>(s.loop_points) + Arena::bytes_for<std::uint32_t>(max_nodes);
+  }
+  return total;
+}
+
+bool LoopClosure::init(const SdpOptions& s, std::uint32_t max_nodes, const LoopSearchGeometry& g, Icp2d* icp,
+                       LoopSubmaps* submaps, LoopClosureStats* stats, Arena& arena) {
+  options_ = s;
+  geometry_ = g;
+  icp_ = icp;
+  submaps_ = submaps;
+  stats_ = stats;
+  max_nodes_ = max_nodes;
+  count_ = 0U;
+  search_level_ = 0U;
+  search_count_ = 0U;
+  search_cursor_ = 0U;
+  search_held_count_ = 0U;
+  records_ = arena.allocate_array<Record>(s.max_loop_constraints);
+  if (records_ == nullptr || !graph_.init(graph_options(s, max_nodes), arena)) return false;
+  if (s.loop_search_window_m > 0.0) {
+    search_a_ = arena.allocate_array<Point2>(s.loop_points);
+    search_b_ = arena.allocate_array<Point2>(s.loop_points);
+    hops_ = arena.allocate_array<std::uint32_t>(max_nodes);
+    if (search_a_ == nullptr || search_b_ == nullptr || hops_ == nullptr ||
+        !matcher_.init(g.grid_side, s.loop_points, search_steps(s, g), arena)) {
+      return false;
+    }
+  }
+  return icp_ != nullptr && submaps_ != nullptr && stats_ != nullptr;
+}
+
+// A record can never join the graph again once one of its levels was forgotten.
+bool LoopClosure::record_dead(const Record& r) const {
+  std::uint32_t index = 0U;
+  return !submaps_->node_index(r.older_level, &index) || !submaps_->node_index(r.newer_level, &index);
+}
+
+Icp2dOptions LoopClosure::icp_options() const {
+  Icp2dOptions fine = options_.icp;
+  fine.max_correspondence_m = options_.loop_icp_max_correspondence_m;
+  fine.min_pairs = options_.loop_min_pairs;
+  return fine;
+}
+
+// The pairing's direction information M (icp2d.h) weights the constraint per direction
+// (FrameInfo::from_directions): a corridor match keeps its across-corridor information.
+FrameInfo LoopClosure::information(const Point2* target, std::uint32_t target_count, const Point2* source,
+                                   std::uint32_t source_count, const Pose2& z) {
+  const FrameInfo iso = FrameInfo::from_sigma(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad);
+  if (!(options_.loop_normal_radius_m > 0.0)) return iso;
+  Icp2dInformation m;
+  if (!icp_->direction_information(target, target_count, source, source_count, z, icp_options(),
+                                   options_.loop_normal_radius_m, &m)) {
+    ++stats_->loop_information_unmeasured;
+    return iso;
+  }
+  const FrameInfo info = FrameInfo::from_directions(options_.loop_sigma_xy_m, options_.loop_sigma_theta_rad, m.xx, m.xy,
+                                                    m.yy, options_.loop_weak_direction_floor, z.heading_rad);
+  if (!info.valid()) {
+    ++stats_->loop_information_unmeasured;
+    return iso;
+  }
+  // Weak: some direction keeps less than half of the isotropic information.
+  if (info.xx * info.yy - info.xy * info.xy < 0.5 * iso.xx * iso.yy) ++stats_->loop_constraints_weak_direction;
+  return info;
+}
+
+void LoopClosure::refine(std::uint32_t older_level, const Point2* older, std::uint32_t older_count,
+                         std::uint32_t newer_level, const Point2* newer, std::uint32_t newer_count, const Pose2& guess,
+                         const Pose2& skeleton) {
+  if (older_count < options_.loop_min_pairs || newer_count < options_.loop_min_pairs) return;
+  const Icp2dResult f = icp_->match(older, older_count, newer, newer_count, skeleton, icp_options());
+  ++stats_->loop_refinements;
+  const Pose2 moved = between(guess, f.transform);
+  if (!(f.usable() && f.mean_nn_error_m <= options_.loop_max_error_m && f.matched_pairs >= options_.loop_min_pairs &&
+        det::sqrt(moved.x_m * moved.x_m + moved.y_m * moved.y_m) <= options_.loop_max_correction_m)) {
+    return;
+  }
+  Record r;
+  r.older_level = older_level;
+  r.newer_level = newer_level;
+  r.z = f.transform;
+  r.error_m = f.mean_nn_error_m;
+  r.info = information(older, older_count, newer, newer_count, f.transform);
+  record(r);
+}
+
+// One record per pair of levels (the lowest residual wins). When the store is full a
+// dead record makes room, else the worst record if the new one is better.
+void LoopClosure::record(const Record& r) {
+  std::uint32_t worst = count_;
+  std::uint32_t dead = count_;
+  for (std::uint32_t k = 0; k < count_; ++k) {
+    Record& q = records_[k];
+    if (q.older_level == r.older_level && q.newer_level == r.newer_level) {
+      if (r.error_m < q.error_m) {
+        const bool searched = q.searched || r.searched;
+        q = r;
+        q.searched = searched;
+      }
+      return;
+    }
+    if (dead == count_ && count_ == options_.max_loop_constraints && record_dead(q)) dead = k;
+    if (worst == count_ || q.error_m > records_[worst].error_m) worst = k;
+  }
+  ++stats_->loop_records_added;
+  if (count_ < options_.max_loop_constraints) {
+    records_[count_++] = r;
+  } else if (dead < count_) {
+    records_[dead] = r;
+  } else if (worst < count_ && r.error_m < records_[worst].error_m) {
+    records_[worst] = r;
+    ++stats_->loop_records_dropped;
+  } else {
+    ++stats_->loop_records_dropped;
+  }
+  stats_->loop_records = count_;
+}
+
+FrameGraph& LoopClosure::begin_adjustment() {
+  graph_.clear();
+  return graph_;
+}
+
+bool LoopClosure::finish_adjustment() {
+  FrameGraph& g = graph_;
+  std::uint32_t used = 0U;
+  for (std::uint32_t k = 0; k < count_; ++k) {
+    const Record& r = records_[k];
+    std::uint32_t a = 0U, b = 0U;
+    if (!submaps_->node_index(r.older_level, &a) || !submaps_->node_index(r.newer_level, &b)) continue;
+    // The search's constraints were verified before they were recorded (search_continue);
+    // the top level's ICP constraints were not, and keep their kernel.
+    const double chi = r.searched ? FrameGraph::kNoKernel : options_.loop_robust_chi;
+    if (g.add_loop(a, b, r.z, r.info, chi)) {
+      ++used;
+    } else {
+      ++stats_->frame_graph_refused;
+    }
+  }
+  stats_->loop_constraints_used = used;
+  if (used == 0U) return false;  // the chain alone is already consistent
+  g.optimise();
+  ++stats_->frame_adjustments;
+  stats_->loop_downweighted = g.stats().last_downweighted;
+  return true;
+}
+
+// ---- wide loop search (correlative_matcher.h) -------------------------------------------
+
+// A search in progress continues; else the next candidate of the level being searched
+// starts, else the next level's candidates are collected (levels in order, each once,
+// as soon as its obstacle points exist).
+void LoopClosure::search_step() {
+  if (!(options_.loop_search_window_m > 0.0) || hops_ == nullptr) return;
+  if (matcher_.active()) {
+    search_continue();
+    return;
+  }
+  if (search_cursor_ >= search_count_) {
+    const std::uint32_t first = submaps_->first_live_level();
+    if (search_level_ < first) search_level_ = first;
+    if (search_level_ >= submaps_->level_end()) return;
+    search_newer_ = search_level_++;
+    search_collect(search_newer_);
+    if (search_count_ == 0U) return;
+  }
+  search_pair(search_older_[search_cursor_++], search_newer_);
+}
+
+// Older held levels (not adjacent, not already constrained to it) whose boxes in the
+// best combination overlap the newer's box grown by the search window; the
+// loop_search_candidates largest overlaps.
+void LoopClosure::search_collect(std::uint32_t newer) {
+  search_count_ = 0U;
+  search_cursor_ = 0U;
+  search_held_count_ = 0U;  // a held peak waits for its own level's other pairs only
+  std::uint32_t n = 0U;
+  Pose2 frame;
+  double box[4];
+  if (!submaps_->placement(newer, &frame, box, &n) || n < options_.loop_min_pairs || !box_valid(box)) return;
+  double nb[4];
+  box_transform(frame, box, nb);
+  const double w = options_.loop_search_window_m;
+  nb[0] -= w;
+  nb[1] -= w;
+  nb[2] += w;
+  nb[3] += w;
+  double area[SdpOptions::kMaxLoopSearchCandidates];
+  const std::uint32_t kmax = options_.loop_search_candidates;
+  for (std::uint32_t older = submaps_->first_held_level(); older + 2U <= newer; ++older) {
+    std::uint32_t on = 0U;
+    Pose2 of;
+    double ob[4];
+    if (!submaps_->placement(older, &of, ob, &on) || on < options_.loop_min_pairs || !box_valid(ob)) continue;
+    bool constrained = false;
+    for (std::uint32_t k = 0; k < count_ && !constrained; ++k) {
+      constrained = records_[k].older_level == older && records_[k].newer_level == newer;
+    }
+    if (constrained) continue;
+    double gb[4];
+    box_transform(of, ob, gb);
+    const double a = box_overlap_m2(gb, nb);
+    if (a < options_.min_overlap_m2 || !(a > 0.0)) continue;
+    std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
+    if (pos == kmax && !(a > area[kmax - 1U])) continue;
+    if (pos == kmax) pos = kmax - 1U;
+    while (pos > 0U && area[pos - 1U] < a) {
+      area[pos] = area[pos - 1U];
+      search_older_[pos] = search_older_[pos - 1U];
+      --pos;
+    }
+    area[pos] = a;
+    search_older_[pos] = older;
+    if (search_count_ < kmax) ++search_count_;
+  }
+}
+
+void LoopClosure::search_pair(std::uint32_t older, std::uint32_t newer) {
+  std::uint32_t tn = 0U;
+  std::uint32_t sn = 0U;
+  Pose2 tframe;
+  Pose2 sframe;
+  double tb[4];
+  double sb[4];
+  // Either level may have been forgotten, or its choice changed, since it was collected.
+  if (!submaps_->placement(older, &tframe, tb, &tn) || !submaps_->placement(newer, &sframe, sb, &sn)) return;
+  ++stats_->loop_searches;
+  submaps_->obstacles(older, search_a_);
+  submaps_->obstacles(newer, search_b_);
+  search_pair_older_ = older;
+  search_pair_newer_ = newer;
+  search_a_count_ = tn;
+  search_b_count_ = sn;
+  CorrelativeOptions co;
+  co.resolution_m = geometry_.resolution_m;
+  co.coarse_cells = kSearchCoarseCells;
+  co.kernel_sigma_m = 1.5 * co.resolution_m;
+  co.window_xy_m = options_.loop_search_window_m;
+  co.window_theta_rad = options_.loop_search_window_rad;
+  co.min_score = options_.loop_search_confirm_score;  // search_continue() holds those below min_score
+  co.max_ambiguity = options_.loop_search_max_ambiguity;
+  if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
+    ++stats_->loop_search_failed;
+    return;
+  }
+  search_continue();
+}
+
+// The coarse pass within the per-scan budget; the fine pass, ICP and the verdict when
+// it is complete.
+void LoopClosure::search_continue() {
+  const std::uint64_t cost = matcher_.heading_cost();
+  std::uint64_t h = cost > 0U ? options_.loop_search_reads_per_scan / cost : 1U;
+  if (h < 1U) h = 1U;
+  if (h > 0xFFFFFFFFULL) h = 0xFFFFFFFFULL;
+  if (!matcher_.advance(static_cast<std::uint32_t>(h))) return;
+  const CorrelativeResult c = matcher_.finish();
+  if (c.status == CorrelativeResult::Status::kWeak) {
+    ++stats_->loop_search_weak;
+    return;
+  }
+  if (c.status == CorrelativeResult::Status::kAmbiguous) {
+    ++stats_->loop_search_ambiguous;
+    return;
+  }
+  if (!c.found()) {
+    ++stats_->loop_search_failed;
+    return;
+  }
+  const Icp2dResult f = icp_->match(search_a_, search_a_count_, search_b_, search_b_count_, c.transform, icp_options());
+  ++stats_->loop_refinements;
+  // ICP only polishes the peak: it must stay within a coarse block of it.
+  const Pose2 polish = between(c.transform, f.transform);
+  const double reach = static_cast<double>(kSearchCoarseCells) * geometry_.resolution_m;
+  if (!f.usable() || f.mean_nn_error_m > options_.loop_max_error_m || f.matched_pairs < options_.loop_min_pairs ||
+      polish.x_m * polish.x_m + polish.y_m * polish.y_m > reach * reach) {
+    ++stats_->loop_search_refuted;
+    return;
+  }
+  Record lr;
+  lr.older_level = search_pair_older_;
+  lr.newer_level = search_pair_newer_;
+  lr.z = f.transform;
+  lr.error_m = f.mean_nn_error_m;
+  lr.info = information(search_a_, search_a_count_, search_b_, search_b_count_, f.transform);
+  lr.searched = true;
+  // Held peaks this one agrees with are corroborated by it (whether it is held or not).
+  bool agreed = false;
+  std::uint32_t kept = 0U;
+  for (std::uint32_t k = 0; k < search_held_count_; ++k) {
+    if (agree(search_held_[k], lr)) {
+      ++stats_->loop_search_corroborated;
+      search_accept(search_held_[k]);
+      agreed = true;
+    } else {
+      search_held_[kept++] = search_held_[k];
+    }
+  }
+  search_held_count_ = kept;
+  const bool far = options_.loop_search_drift_m > 0.0 && moves_too_far(lr);
+  if (c.score < options_.loop_search_min_score || far) {
+    ++stats_->loop_search_held;
+    if (far) ++stats_->loop_search_far;
+    for (std::uint32_t k = 0; k < count_ && !agreed; ++k) {
+      agreed = records_[k].newer_level == lr.newer_level && agree(records_[k], lr);
+    }
+    if (!agreed) {
+      if (search_held_count_ < SdpOptions::kMaxLoopSearchCandidates) search_held_[search_held_count_++] = lr;
+      return;
+    }
+    ++stats_->loop_search_corroborated;
+  }
+  search_accept(lr);
+}
+
+void LoopClosure::search_accept(const Record& r) {
+  ++stats_->loop_search_closed;
+  record(r);
+  if (!record_dead(r)) submaps_->on_verified_loop();  // the frames follow the new constraint now
+}
+
+// Two matches of the same newer submap against different older ones agree when they
+// place it alike in the best combination's frame (each older submap where the frames
+// put it now).
+bool LoopClosure::agree(const Record& a, const Record& b) const {
+  if (a.newer_level != b.newer_level || a.older_level == b.older_level) return false;
+  std::uint32_t n = 0U;
+  Pose2 fa;
+  Pose2 fb;
+  double box[4];
+  if (!submaps_->placement(a.older_level, &fa, box, &n) || !submaps_->placement(b.older_level, &fb, box, &n)) {
+    return false;
+  }
+  const Pose2 d = between(fa.compose(a.z), fb.compose(b.z));
+  const double xy = options_.loop_search_confirm_xy_m;
+  const double th = normalize_angle_rad(d.heading_rad);
+  return d.x_m * d.x_m + d.y_m * d.y_m <= xy * xy && (th < 0.0 ? -th : th) <= options_.loop_search_confirm_rad;
+}
+
+// Whether r would move its newer submap (the centre of its box) farther from where the
+// best combination's frames put it now than the chain may have drifted between the two
+// levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
+bool LoopClosure::moves_too_far(const Record& r) const {
+  std::uint32_t n = 0U;
+  Pose2 fo;
+  Pose2 fn;
+  double ob[4];
+  double nb[4];
+  if (!submaps_->placement(r.older_level, &fo, ob, &n) || !submaps_->placement(r.newer_level, &fn, nb, &n) ||
+      !box_valid(nb)) {
+    return false;
+  }
+  const Pose2 centre{0.5 * (nb[0] + nb[2]), 0.5 * (nb[1] + nb[3]), 0.0};
+  const Pose2 now = fn.compose(centre);
+  const Pose2 moved = fo.compose(r.z).compose(centre);
+  const double dx = moved.x_m - now.x_m;
+  const double dy = moved.y_m - now.y_m;
+  const double limit_m2 = options_.loop_search_drift_m * options_.loop_search_drift_m *
+                          static_cast<double>(level_hops(r.older_level, r.newer_level));
+  return dx * dx + dy * dy > limit_m2;
+}
+
+// The fewest steps between two levels over the frame graph's nodes: chain steps between
+// consecutive levels, one step across each record both of whose levels are held (other
+// than one of this same pair).
+// Bounded work: at most kHopPasses rounds of relaxation (more would only shorten a
+// path that already crosses that many loops); the level gap if either is not held.
+std::uint32_t LoopClosure::level_hops(std::uint32_t older_level, std::uint32_t newer_level) const {
+  constexpr std::uint32_t kHopPasses = 8U;
+  const std::uint32_t gap = newer_level > older_level ? newer_level - older_level : older_level - newer_level;
+  std::uint32_t a = 0U;
+  std::uint32_t b = 0U;
+  if (hops_ == nullptr || !submaps_->node_index(older_level, &a) || !submaps_->node_index(newer_level, &b)) return gap;
+  std::uint32_t n = submaps_->node_count();
+  if (n > max_nodes_) n = max_nodes_;
+  for (std::uint32_t i = 0; i < n; ++i) hops_[i] = i > a ? i - a : a - i;
+  for (std::uint32_t pass = 0; pass < kHopPasses; ++pass) {
+    bool changed = false;
+    for (std::uint32_t k = 0; k < count_; ++k) {
+      const Record& r = records_[k];
+      // A record of the same pair is a rival estimate of this very constraint, not a path.
+      if (r.older_level == older_level && r.newer_level == newer_level) continue;
+      std::uint32_t u = 0U;
+      std::uint32_t v = 0U;
+      if (!submaps_->node_index(r.older_level, &u) || !submaps_->node_index(r.newer_level, &v)) continue;
+      if (hops_[u] + 1U < hops_[v]) {
+        hops_[v] = hops_[u] + 1U;
+        changed = true;
+      } else if (hops_[v] + 1U < hops_[u]) {
+        hops_[u] = hops_[v] + 1U;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+    for (std::uint32_t i = 1; i < n; ++i) {
+      if (hops_[i - 1U] + 1U < hops_[i]) hops_[i] = hops_[i - 1U] + 1U;
+    }
+    for (std::uint32_t i = n - 1U; i > 0U; --i) {
+      if (hops_[i] + 1U < hops_[i - 1U]) hops_[i - 1U] = hops_[i] + 1U;
+    }
+  }
+  return hops_[b];
+}
+
+}  // namespace sdpslam

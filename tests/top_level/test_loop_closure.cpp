@@ -1,0 +1,300 @@
+// LoopClosure (core/loop_closure.h) through its own API, on submaps given by a fake
+// owner (LoopSubmaps): a room seen by two submaps whose frames the chain placed metres
+// apart. The wide search finds the revisit and records it, verified, and the pose graph
+// then moves the drifted frame onto it; a revisit beyond the chain's drift is held until
+// a second older submap agrees, and stays held without one; the top level's matches are
+// refined and kept one per pair of levels, the best residual winning; a full store makes
+// room with a record whose levels are gone; nothing is searched without a window.
+#include <cmath>
+#include <vector>
+
+#include "CppUTest/TestHarness.h"
+#include "sdpslam/core/box2.h"
+#include "sdpslam/core/loop_closure.h"
+#include "sdpslam/core/sdp_profile.h"
+
+using namespace sdpslam;
+
+namespace {
+
+// Wall points of a room 9 m × 6 m with a pillar and an alcove (no symmetry a search
+// could confuse), every 0.1 m, in the room's frame.
+std::vector<Point2> room() {
+  std::vector<Point2> p;
+  auto wall = [&](double x0, double y0, double x1, double y1) {
+    const double len = std::hypot(x1 - x0, y1 - y0);
+    const int n = static_cast<int>(len / 0.1);
+    for (int k = 0; k <= n; ++k) {
+      const double t = n > 0 ? static_cast<double>(k) / n : 0.0;
+      p.push_back(Point2{x0 + t * (x1 - x0), y0 + t * (y1 - y0)});
+    }
+  };
+  wall(0.0, 0.0, 9.0, 0.0);
+  wall(9.0, 0.0, 9.0, 6.0);
+  wall(9.0, 6.0, 4.0, 6.0);
+  wall(4.0, 6.0, 4.0, 7.5);  // alcove
+  wall(4.0, 7.5, 2.0, 7.5);
+  wall(2.0, 7.5, 2.0, 6.0);
+  wall(2.0, 6.0, 0.0, 6.0);
+  wall(0.0, 6.0, 0.0, 0.0);
+  wall(6.0, 2.0, 7.0, 2.0);  // pillar
+  wall(7.0, 2.0, 7.0, 3.0);
+  wall(7.0, 3.0, 6.0, 3.0);
+  wall(6.0, 3.0, 6.0, 2.0);
+  // At most loop_points (300): every other point.
+  std::vector<Point2> thin;
+  for (std::size_t k = 0; k < p.size(); k += 2) thin.push_back(p[k]);
+  return thin;
+}
+
+// A corridor far from the room: 20 m of two parallel walls, 2 m apart.
+std::vector<Point2> corridor(double x0_m) {
+  std::vector<Point2> p;
+  for (int k = 0; k <= 100; ++k) {
+    p.push_back(Point2{x0_m + 0.2 * k, 40.0});
+    p.push_back(Point2{x0_m + 0.2 * k, 42.0});
+  }
+  return p;
+}
+
+// The owner: levels 0 .. n-1, all held and live; each with its frame (as the chain
+// placed it), its obstacle points and its box.
+struct Owner final : LoopSubmaps {
+  struct Level {
+    Pose2 frame;
+    std::vector<Point2> points;
+  };
+  std::vector<Level> levels;
+  std::uint32_t first_held = 0U;
+  int verified = 0;
+  bool node_index(std::uint32_t level, std::uint32_t* index) const override {
+    if (level < first_held || level >= levels.size()) return false;
+    *index = level - first_held;
+    return true;
+  }
+  std::uint32_t node_count() const override { return static_cast<std::uint32_t>(levels.size()) - first_held; }
+  std::uint32_t first_held_level() const override { return first_held; }
+  std::uint32_t first_live_level() const override { return first_held; }
+  std::uint32_t level_end() const override { return static_cast<std::uint32_t>(levels.size()); }
+  bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* count) const override {
+    std::uint32_t index = 0U;
+    if (!node_index(level, &index)) return false;
+    const Level& l = levels[level];
+    *frame = l.frame;
+    box_init(box);
+    for (const Point2& q : l.points) box_add(box, q.x_m, q.y_m);
+    *count = static_cast<std::uint32_t>(l.points.size());
+    return true;
+  }
+  void obstacles(std::uint32_t level, Point2* out) const override {
+    for (std::size_t k = 0; k < levels[level].points.size(); ++k) out[k] = levels[level].points[k];
+  }
+  void on_verified_loop() override { ++verified; }
+};
+
+SdpOptions accurate() {
+  DpSlamOptions bottom;
+  SdpOptions top;
+  apply_profile(SdpProfile::kAccurate, &bottom, &top);
+  return top;
+}
+
+struct Rig {
+  alignas(std::max_align_t) unsigned char buffer[8U << 20];
+  Arena arena{buffer, sizeof buffer};
+  Icp2d icp;
+  Owner owner;
+  LoopClosureStats stats;
+  LoopClosure loops;
+  SdpOptions options = accurate();
+  bool init() {
+    LoopSearchGeometry g;
+    g.resolution_m = 0.1;
+    g.grid_side = 260U;
+    const std::uint32_t nodes = 16U;
+    if (LoopClosure::required_bytes(options, nodes, g) > arena.available_bytes()) return false;
+    return loops.init(options, nodes, g, &icp, &owner, &stats, arena);
+  }
+  // Runs the search until every level has been searched (bounded).
+  void search_all() {
+    for (int k = 0; k < 2000; ++k) loops.search_step();
+  }
+};
+
+double distance_m(const Pose2& a, const Pose2& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
+double angle_rad(const Pose2& a, const Pose2& b) { return std::fabs(normalize_angle_rad(a.heading_rad - b.heading_rad)); }
+
+}  // namespace
+
+TEST_GROUP(LoopClosure) {
+  Rig* rig = nullptr;
+  void setup() override { rig = new Rig(); }
+  void teardown() override { delete rig; }
+};
+
+// Level 2 revisits level 0's room; the chain placed it 2 m and 0.1 rad from where it is.
+TEST(LoopClosure, the_wide_search_finds_a_revisit_the_chain_placed_metres_off_and_the_graph_follows) {
+  const Pose2 truth2{3.0, -1.0, 0.4};  // level 2's frame in level 0's (the room's)
+  const Pose2 believed2 = truth2.compose(Pose2{2.0, 0.0, 0.1});
+  Owner& o = rig->owner;
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{1.5, 20.0, 0.2}, corridor(0.0)});
+  o.levels.push_back({believed2, {}});
+  for (const Point2& q : room()) {  // the room in level 2's frame
+    double x = 0.0, y = 0.0;
+    truth2.inverse().transform_point(q.x_m, q.y_m, x, y);
+    o.levels[2].points.push_back(Point2{x, y});
+  }
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  const LoopClosure::Record& r = rig->loops.record(0);
+  CHECK_EQUAL(0U, r.older_level);
+  CHECK_EQUAL(2U, r.newer_level);
+  CHECK_TRUE(r.searched);
+  CHECK_TRUE(distance_m(r.z, truth2) < 0.05);
+  CHECK_TRUE(angle_rad(r.z, truth2) < 0.01);
+  CHECK_EQUAL(1, o.verified);
+  CHECK_TRUE(rig->stats.loop_searches >= 1U);
+  CHECK_EQUAL(1U, rig->stats.loop_search_closed);
+  // The graph: the chain as the owner has it, then the loop.
+  FrameGraph& g = rig->loops.begin_adjustment();
+  const FrameInfo seg = FrameInfo::from_sigma(rig->options.segment_sigma_xy_m, rig->options.segment_sigma_theta_rad);
+  for (std::size_t k = 0; k < o.levels.size(); ++k) {
+    const Pose2 t = k > 0 ? between(o.levels[k - 1].frame, o.levels[k].frame) : Pose2{};
+    CHECK_TRUE(g.add_node(o.levels[k].frame, t, seg));
+  }
+  CHECK_TRUE(rig->loops.finish_adjustment());
+  CHECK_EQUAL(1U, rig->stats.loop_constraints_used);
+  CHECK_EQUAL(1U, rig->stats.frame_adjustments);
+  // Verified, so without a kernel: the loop moves level 2 most of the way from the
+  // chain's 2 m (least squares leaves the chain's own information a share).
+  const double after = distance_m(g.frame(2), truth2);
+  std::printf("\n  level 2 after the solve: %.3f m from its true frame (chain: 2 m)\n", after);
+  CHECK_TRUE(after < 0.3);
+  DOUBLES_EQUAL(0.0, distance_m(g.frame(0), Pose2{}), 0.0);
+}
+
+// Level 3 revisits the room, but the chain put it 5 m off: more than loop_search_drift_m
+// × √hops (2 m × √3). Held; a second older submap of the same room placing it alike
+// makes both constraints.
+TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_held_until_a_second_submap_agrees) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  Owner& o = rig->owner;
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{}, room()});  // the same room, from the next segment
+  o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), {}});
+  for (const Point2& q : room()) {
+    double x = 0.0, y = 0.0;
+    truth3.inverse().transform_point(q.x_m, q.y_m, x, y);
+    o.levels[3].points.push_back(Point2{x, y});
+  }
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_TRUE(rig->stats.loop_search_far >= 1U);
+  CHECK_TRUE(rig->stats.loop_search_corroborated >= 1U);
+  CHECK_EQUAL(2U, rig->loops.record_count());
+  for (std::uint32_t k = 0; k < 2U; ++k) {
+    CHECK_EQUAL(3U, rig->loops.record(k).newer_level);
+    CHECK_TRUE(distance_m(rig->loops.record(k).z, truth3) < 0.05);
+  }
+}
+
+TEST(LoopClosure, a_revisit_beyond_the_chain_drift_without_a_second_witness_stays_held) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  Owner& o = rig->owner;
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{0.0, 60.0, 0.0}, corridor(30.0)});
+  o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), {}});
+  for (const Point2& q : room()) {
+    double x = 0.0, y = 0.0;
+    truth3.inverse().transform_point(q.x_m, q.y_m, x, y);
+    o.levels[3].points.push_back(Point2{x, y});
+  }
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_EQUAL(1U, rig->stats.loop_search_held);
+  CHECK_EQUAL(1U, rig->stats.loop_search_far);
+  CHECK_EQUAL(0U, rig->loops.record_count());
+  CHECK_EQUAL(0, o.verified);
+}
+
+// The top level's skeleton match, refined on obstacle points: one record per pair of
+// levels, the lower residual wins; a match that moves the submap farther than
+// loop_max_correction_m from its guess is not kept.
+TEST(LoopClosure, refined_matches_are_kept_one_per_pair_of_levels) {
+  Owner& o = rig->owner;
+  for (int k = 0; k < 4; ++k) o.levels.push_back({Pose2{}, room()});
+  CHECK_TRUE(rig->init());
+  const std::vector<Point2> a = room();
+  std::vector<Point2> b;
+  const Pose2 z{0.3, -0.2, 0.05};
+  for (const Point2& q : a) {
+    double x = 0.0, y = 0.0;
+    z.inverse().transform_point(q.x_m, q.y_m, x, y);
+    b.push_back(Point2{x, y});
+  }
+  const auto n = static_cast<std::uint32_t>(a.size());
+  rig->loops.refine(0U, a.data(), n, 2U, b.data(), n, z, z);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  CHECK_FALSE(rig->loops.record(0).searched);
+  const double first_error = rig->loops.record(0).error_m;
+  // The same pair with noisier points: the better record stays.
+  std::vector<Point2> noisy = b;
+  for (std::size_t k = 0; k < noisy.size(); ++k) noisy[k].x_m += (k % 2 == 0 ? 0.04 : -0.04);
+  rig->loops.refine(0U, a.data(), n, 2U, noisy.data(), n, z, z);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  DOUBLES_EQUAL(first_error, rig->loops.record(0).error_m, 0.0);
+  // A guess 2 m from the match: beyond loop_max_correction_m (1 m).
+  rig->loops.refine(1U, a.data(), n, 3U, b.data(), n, z.compose(Pose2{2.0, 0.0, 0.0}), z);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  CHECK_EQUAL(3U, rig->stats.loop_refinements);
+  // Too few points: not even tried.
+  rig->loops.refine(1U, a.data(), 10U, 3U, b.data(), n, z, z);
+  CHECK_EQUAL(3U, rig->stats.loop_refinements);
+}
+
+TEST(LoopClosure, a_full_store_makes_room_with_a_record_whose_levels_are_gone) {
+  rig->options.max_loop_constraints = 2U;
+  Owner& o = rig->owner;
+  for (int k = 0; k < 6; ++k) o.levels.push_back({Pose2{}, room()});
+  CHECK_TRUE(rig->init());
+  const std::vector<Point2> a = room();
+  const auto n = static_cast<std::uint32_t>(a.size());
+  rig->loops.refine(0U, a.data(), n, 2U, a.data(), n, Pose2{}, Pose2{});
+  rig->loops.refine(1U, a.data(), n, 3U, a.data(), n, Pose2{}, Pose2{});
+  CHECK_EQUAL(2U, rig->loops.record_count());
+  o.first_held = 1U;  // level 0 is forgotten: its record can never be used again
+  rig->loops.refine(2U, a.data(), n, 4U, a.data(), n, Pose2{}, Pose2{});
+  CHECK_EQUAL(2U, rig->loops.record_count());
+  CHECK_EQUAL(0U, rig->stats.loop_records_dropped);
+  bool has_24 = false, has_02 = false;
+  for (std::uint32_t k = 0; k < 2U; ++k) {
+    has_24 = has_24 || (rig->loops.record(k).older_level == 2U && rig->loops.record(k).newer_level == 4U);
+    has_02 = has_02 || rig->loops.record(k).older_level == 0U;
+  }
+  CHECK_TRUE(has_24);
+  CHECK_FALSE(has_02);
+  // Full of live records, all as good as a new one: the new one is dropped and counted.
+  rig->loops.refine(3U, a.data(), n, 5U, a.data(), n, Pose2{}, Pose2{});
+  CHECK_EQUAL(1U, rig->stats.loop_records_dropped);
+}
+
+TEST(LoopClosure, nothing_is_searched_without_a_window_and_an_empty_graph_is_not_solved) {
+  rig->options.loop_search_window_m = 0.0;
+  Owner& o = rig->owner;
+  for (int k = 0; k < 3; ++k) o.levels.push_back({Pose2{}, room()});
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_EQUAL(0U, rig->stats.loop_searches);
+  FrameGraph& g = rig->loops.begin_adjustment();
+  CHECK_TRUE(g.add_node(Pose2{}, Pose2{}, FrameInfo::from_sigma(0.1, 0.02)));
+  CHECK_TRUE(g.add_node(Pose2{1.0, 0.0, 0.0}, Pose2{1.0, 0.0, 0.0}, FrameInfo::from_sigma(0.1, 0.02)));
+  CHECK_FALSE(rig->loops.finish_adjustment());
+  CHECK_EQUAL(0U, rig->stats.frame_adjustments);
+  SdpOptions off = accurate();
+  off.loop_closure = false;
+  CHECK_EQUAL(0U, LoopClosure::required_bytes(off, 16U, LoopSearchGeometry{}));
+}
