@@ -352,18 +352,26 @@ void LoopClosure::search_accept(const Record& r) {
   if (!record_dead(r)) submaps_->on_verified_loop();  // the frames follow the new constraint now
 }
 
-// Two matches of the same newer submap against different older ones agree when they
-// place it alike in the best combination's frame (each older submap where the frames
-// put it now).
+// Two matches of the same newer submap against different older ones agree when the
+// older submaps are independent witnesses — their boxes, where the best combination's
+// frames put them now, share no area (two submaps of one corridor see the same walls,
+// and an aliased match against one repeats against the other) — and they place the
+// newer submap alike in that frame.
 bool LoopClosure::agree(const Record& a, const Record& b) const {
   if (a.newer_level != b.newer_level || a.older_level == b.older_level) return false;
   std::uint32_t n = 0U;
   Pose2 fa;
   Pose2 fb;
-  double box[4];
-  if (!submaps_->placement(a.older_level, &fa, box, &n) || !submaps_->placement(b.older_level, &fb, box, &n)) {
+  double ba[4];
+  double bb[4];
+  if (!submaps_->placement(a.older_level, &fa, ba, &n) || !submaps_->placement(b.older_level, &fb, bb, &n)) {
     return false;
   }
+  double ga[4];
+  double gb[4];
+  box_transform(fa, ba, ga);
+  box_transform(fb, bb, gb);
+  if (box_overlap_m2(ga, gb) > 0.0) return false;
   const Pose2 d = between(fa.compose(a.z), fb.compose(b.z));
   const double xy = options_.loop_search_confirm_xy_m;
   const double th = normalize_angle_rad(d.heading_rad);

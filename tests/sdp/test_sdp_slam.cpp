@@ -334,10 +334,12 @@ TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
 }
 
 // A peak between loop_search_confirm_score and loop_search_min_score closes a loop only
-// when another older submap places the same newer one alike. With min_score out of reach
-// every closure must have been corroborated; with no tolerance none is; with the held
+// when an older submap of another place (sharing no area with the first) places the same
+// newer one alike (test_loop_closure.cpp shows such a witness closing it). This world is
+// one room walked round: every older submap shares the room, so no second opinion is a
+// witness, and with min_score out of reach peaks are held and none closes; with the held
 // band empty nothing is held.
-TEST(SdpSlam, weak_search_peaks_close_loops_only_when_a_second_older_submap_agrees) {
+TEST(SdpSlam, weak_search_peaks_close_loops_only_when_an_independent_older_submap_agrees) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
@@ -345,22 +347,11 @@ TEST(SdpSlam, weak_search_peaks_close_loops_only_when_a_second_older_submap_agre
   s.loop_search_min_score = 1.0;
   s.loop_search_confirm_score = 0.4;
   auto run = [&](const SdpOptions& o, double* error_m) { return run_loop_search(set, o, error_m); };
-  double agreed_m = 0.0;
-  const SdpStats a = run(s, &agreed_m);
+  const SdpStats a = run(s, nullptr);
   CHECK(a.loop_search_held > 0U);
-  CHECK(a.loop_search_corroborated > 0U);
-  CHECK(a.loop_search_corroborated <= a.loop_search_held);
-  LONGS_EQUAL(a.loop_search_corroborated, a.loop_search_closed);
-  std::printf("\n  held search peaks: %llu held, %llu corroborated, mean position error %.3f m\n",
-              static_cast<unsigned long long>(a.loop_search_held),
-              static_cast<unsigned long long>(a.loop_search_corroborated), agreed_m);
-  SdpOptions strict = s;
-  strict.loop_search_confirm_xy_m = 0.0;
-  strict.loop_search_confirm_rad = 0.0;
-  const SdpStats b = run(strict, nullptr);
-  CHECK(b.loop_search_held > 0U);
-  LONGS_EQUAL(0, b.loop_search_corroborated);
-  LONGS_EQUAL(0, b.loop_search_closed);
+  LONGS_EQUAL(0, a.loop_search_corroborated);
+  LONGS_EQUAL(0, a.loop_search_closed);
+  std::printf("\n  held search peaks: %llu held, none closed\n", static_cast<unsigned long long>(a.loop_search_held));
   SdpOptions off = s;
   off.loop_search_confirm_score = off.loop_search_min_score;
   const SdpStats c = run(off, nullptr);
@@ -370,9 +361,9 @@ TEST(SdpSlam, weak_search_peaks_close_loops_only_when_a_second_older_submap_agre
 
 // A peak that would move its newer submap farther than the chain can have drifted
 // (loop_search_drift_m × √hops) is held like a weak one: with no drift allowed every
-// closure needs a second older submap's agreement; with the gate off nothing is held
-// for its shift.
-TEST(SdpSlam, far_search_peaks_close_loops_only_when_a_second_older_submap_agrees) {
+// closure needs an independent older submap's agreement (none in this one-room world);
+// with the gate off nothing is held for its shift.
+TEST(SdpSlam, far_search_peaks_close_loops_only_when_an_independent_older_submap_agrees) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;

@@ -2,7 +2,8 @@
 // owner (LoopSubmaps): a room seen by two submaps whose frames the chain placed metres
 // apart. The wide search finds the revisit and records it, verified, and the pose graph
 // then moves the drifted frame onto it; a revisit beyond the chain's drift is held until
-// a second older submap agrees, and stays held without one; the top level's matches are
+// a submap of another place agrees, and stays held without one or when the second
+// opinion comes from a submap of the same place; the top level's matches are
 // refined and kept one per pair of levels, the best residual winning; a full store makes
 // room with a record whose levels are gone; nothing is searched without a window.
 #include <cmath>
@@ -18,8 +19,8 @@ using namespace sdpslam;
 namespace {
 
 // Wall points of a room 9 m × 6 m with a pillar and an alcove (no symmetry a search
-// could confuse), every 0.1 m, in the room's frame.
-std::vector<Point2> room() {
+// could confuse), every 0.1 m × `stride`, in the room's frame.
+std::vector<Point2> room(std::size_t stride = 2) {
   std::vector<Point2> p;
   auto wall = [&](double x0, double y0, double x1, double y1) {
     const double len = std::hypot(x1 - x0, y1 - y0);
@@ -41,9 +42,9 @@ std::vector<Point2> room() {
   wall(7.0, 2.0, 7.0, 3.0);
   wall(7.0, 3.0, 6.0, 3.0);
   wall(6.0, 3.0, 6.0, 2.0);
-  // At most loop_points (300): every other point.
+  // At most loop_points (300) per submap.
   std::vector<Point2> thin;
-  for (std::size_t k = 0; k < p.size(); k += 2) thin.push_back(p[k]);
+  for (std::size_t k = 0; k < p.size(); k += stride) thin.push_back(p[k]);
   return thin;
 }
 
@@ -121,6 +122,18 @@ struct Rig {
   }
 };
 
+// Points given in frame `from`, expressed in frame `to` (both in one parent frame).
+std::vector<Point2> seen_from(const std::vector<Point2>& points, const Pose2& from, const Pose2& to) {
+  std::vector<Point2> out;
+  const Pose2 t = between(to, from);
+  for (const Point2& q : points) {
+    double x = 0.0, y = 0.0;
+    t.transform_point(q.x_m, q.y_m, x, y);
+    out.push_back(Point2{x, y});
+  }
+  return out;
+}
+
 double distance_m(const Pose2& a, const Pose2& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
 double angle_rad(const Pose2& a, const Pose2& b) { return std::fabs(normalize_angle_rad(a.heading_rad - b.heading_rad)); }
 
@@ -139,12 +152,7 @@ TEST(LoopClosure, the_wide_search_finds_a_revisit_the_chain_placed_metres_off_an
   Owner& o = rig->owner;
   o.levels.push_back({Pose2{}, room()});
   o.levels.push_back({Pose2{1.5, 20.0, 0.2}, corridor(0.0)});
-  o.levels.push_back({believed2, {}});
-  for (const Point2& q : room()) {  // the room in level 2's frame
-    double x = 0.0, y = 0.0;
-    truth2.inverse().transform_point(q.x_m, q.y_m, x, y);
-    o.levels[2].points.push_back(Point2{x, y});
-  }
+  o.levels.push_back({believed2, seen_from(room(), Pose2{}, truth2)});  // the room in level 2's frame
   CHECK_TRUE(rig->init());
   rig->search_all();
   CHECK_EQUAL(1U, rig->loops.record_count());
@@ -175,21 +183,19 @@ TEST(LoopClosure, the_wide_search_finds_a_revisit_the_chain_placed_metres_off_an
   DOUBLES_EQUAL(0.0, distance_m(g.frame(0), Pose2{}), 0.0);
 }
 
-// Level 3 revisits the room, but the chain put it 5 m off: more than loop_search_drift_m
-// × √hops (2 m × √3). Held; a second older submap of the same room placing it alike
-// makes both constraints.
-TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_held_until_a_second_submap_agrees) {
+// Level 3 revisits two rooms side by side, level 0's and level 1's, but the chain put it
+// 5 m off: more than loop_search_drift_m × √hops (2 m × √3). Each match alone is held;
+// the second, from a submap of another place (an independent witness), places level 3
+// alike and makes both constraints.
+TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_held_until_a_submap_of_another_place_agrees) {
   const Pose2 truth3{2.0, 1.0, -0.3};
+  const Pose2 room_b{20.0, 0.0, 1.5707963};  // level 1's room, beside level 0's and turned
   Owner& o = rig->owner;
   o.levels.push_back({Pose2{}, room()});
-  o.levels.push_back({Pose2{}, room()});  // the same room, from the next segment
+  o.levels.push_back({room_b, room()});
   o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
-  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), {}});
-  for (const Point2& q : room()) {
-    double x = 0.0, y = 0.0;
-    truth3.inverse().transform_point(q.x_m, q.y_m, x, y);
-    o.levels[3].points.push_back(Point2{x, y});
-  }
+  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), seen_from(room(4), Pose2{}, truth3)});
+  for (const Point2& q : seen_from(room(4), room_b, truth3)) o.levels[3].points.push_back(q);
   CHECK_TRUE(rig->init());
   rig->search_all();
   CHECK_TRUE(rig->stats.loop_search_far >= 1U);
@@ -197,8 +203,26 @@ TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_held_until_a_second_submap
   CHECK_EQUAL(2U, rig->loops.record_count());
   for (std::uint32_t k = 0; k < 2U; ++k) {
     CHECK_EQUAL(3U, rig->loops.record(k).newer_level);
-    CHECK_TRUE(distance_m(rig->loops.record(k).z, truth3) < 0.05);
+    CHECK_TRUE(distance_m(rig->loops.record(k).z, k == 0U ? truth3 : between(room_b, truth3)) < 0.05 ||
+               distance_m(rig->loops.record(k).z, k == 0U ? between(room_b, truth3) : truth3) < 0.05);
   }
+}
+
+// The same, but levels 0 and 1 are two submaps of the same room: the second match agrees
+// with the first, yet it is no witness (whatever misled one would mislead the other).
+TEST(LoopClosure, a_second_submap_of_the_same_place_is_no_witness) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  Owner& o = rig->owner;
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), seen_from(room(), Pose2{}, truth3)});
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_EQUAL(2U, rig->stats.loop_search_held);
+  CHECK_EQUAL(0U, rig->stats.loop_search_corroborated);
+  CHECK_EQUAL(0U, rig->loops.record_count());
+  CHECK_EQUAL(0, o.verified);
 }
 
 TEST(LoopClosure, a_revisit_beyond_the_chain_drift_without_a_second_witness_stays_held) {
@@ -207,12 +231,7 @@ TEST(LoopClosure, a_revisit_beyond_the_chain_drift_without_a_second_witness_stay
   o.levels.push_back({Pose2{}, room()});
   o.levels.push_back({Pose2{0.0, 60.0, 0.0}, corridor(30.0)});
   o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
-  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), {}});
-  for (const Point2& q : room()) {
-    double x = 0.0, y = 0.0;
-    truth3.inverse().transform_point(q.x_m, q.y_m, x, y);
-    o.levels[3].points.push_back(Point2{x, y});
-  }
+  o.levels.push_back({truth3.compose(Pose2{5.0, 0.0, 0.05}), seen_from(room(), Pose2{}, truth3)});
   CHECK_TRUE(rig->init());
   rig->search_all();
   CHECK_EQUAL(1U, rig->stats.loop_search_held);

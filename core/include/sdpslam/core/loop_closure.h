@@ -30,8 +30,8 @@
 // loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak that
 // obstacle ICP confirms becomes a constraint when it scores loop_search_min_score and
 // stays within the chain's drift (loop_search_drift_m × √hops); a weaker or farther one
-// is held until a second older submap places the newer one alike
-// (loop_search_confirm_xy_m / _rad). A recorded search constraint asks the owner to
+// is held until a second older submap, one that shares no area with the first (an
+// independent witness), places the newer one alike (loop_search_confirm_xy_m / _rad). A recorded search constraint asks the owner to
 // adjust at once (LoopSubmaps::on_verified_loop), so the next pair is judged against the
 // corrected frames.
 //

@@ -159,10 +159,12 @@ struct SdpOptions {
   // (and passing the same ICP tests) is held, not trusted: it becomes a constraint only
   // when another pair of the same newer submap places that submap the same way (within
   // loop_search_confirm_xy_m and loop_search_confirm_rad in the best combination's
-  // frame): a second older submap, searched or already constrained to it. Two false
-  // matches against different submaps seldom agree; a true loop seen weakly by each
-  // older submap it revisits does: a true loop seen only weakly still closes. Equal to
-  // loop_search_min_score: off.
+  // frame): a second older submap, searched or already constrained to it, that shares
+  // no area with the first (their boxes in that frame do not overlap). Two false matches
+  // against submaps of different places seldom agree; against two submaps of one
+  // corridor they do (both see the same doors at the same pitch), so such a second
+  // opinion is no witness. A true loop seen weakly by each place it revisits does agree:
+  // a true loop seen only weakly still closes. Equal to loop_search_min_score: off.
   double loop_search_confirm_score = 0.40;     // (0, loop_search_min_score]
   double loop_search_confirm_xy_m = 0.30;      // [0, 10]
   double loop_search_confirm_rad = 0.05;       // [0, pi]
