@@ -108,13 +108,20 @@ void LoopClosure::refine(std::uint32_t older_level, const Point2* older, std::ui
         det::sqrt(moved.x_m * moved.x_m + moved.y_m * moved.y_m) <= options_.loop_max_correction_m)) {
     return;
   }
+  record(matched(older_level, older, older_count, newer_level, newer, newer_count, f, false));
+}
+
+LoopClosure::Record LoopClosure::matched(std::uint32_t older_level, const Point2* older, std::uint32_t older_count,
+                                         std::uint32_t newer_level, const Point2* newer, std::uint32_t newer_count,
+                                         const Icp2dResult& f, bool searched) {
   Record r;
   r.older_level = older_level;
   r.newer_level = newer_level;
   r.z = f.transform;
   r.error_m = f.mean_nn_error_m;
   r.info = information(older, older_count, newer, newer_count, f.transform);
-  record(r);
+  r.searched = searched;
+  return r;
 }
 
 // One record per pair of levels (the lowest residual wins). When the store is full a
@@ -310,13 +317,8 @@ void LoopClosure::search_continue() {
     ++stats_->loop_search_refuted;
     return;
   }
-  Record lr;
-  lr.older_level = search_pair_older_;
-  lr.newer_level = search_pair_newer_;
-  lr.z = f.transform;
-  lr.error_m = f.mean_nn_error_m;
-  lr.info = information(search_a_, search_a_count_, search_b_, search_b_count_, f.transform);
-  lr.searched = true;
+  const Record lr =
+      matched(search_pair_older_, search_a_, search_a_count_, search_pair_newer_, search_b_, search_b_count_, f, true);
   // Held peaks this one agrees with are corroborated by it (whether it is held or not).
   bool agreed = false;
   std::uint32_t kept = 0U;

@@ -155,6 +155,9 @@ class LoopClosure {
   // older's) from the direction information of that pairing (loop_normal_radius_m).
   FrameInfo information(const Point2* target, std::uint32_t target_count, const Point2* source,
                         std::uint32_t source_count, const Pose2& z);
+  // The record of a refined match (ICP result f of the newer submap's points on the older's).
+  Record matched(std::uint32_t older_level, const Point2* older, std::uint32_t older_count, std::uint32_t newer_level,
+                 const Point2* newer, std::uint32_t newer_count, const Icp2dResult& f, bool searched);
   void search_collect(std::uint32_t newer_level);
   void search_pair(std::uint32_t older_level, std::uint32_t newer_level);
   void search_continue();
