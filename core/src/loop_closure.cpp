@@ -46,7 +46,6 @@ bool LoopClosure::init(const SdpOptions& s, std::uint32_t max_nodes, const LoopS
   search_level_ = 0U;
   search_count_ = 0U;
   search_cursor_ = 0U;
-  search_held_count_ = 0U;
   records_ = arena.allocate_array<Record>(s.max_loop_constraints);
   if (records_ == nullptr || !graph_.init(graph_options(s, max_nodes), arena)) return false;
   if (s.loop_search_window_m > 0.0) {
@@ -213,7 +212,6 @@ void LoopClosure::search_step() {
 void LoopClosure::search_collect(std::uint32_t newer) {
   search_count_ = 0U;
   search_cursor_ = 0U;
-  search_held_count_ = 0U;  // a held peak waits for its own level's other pairs only
   std::uint32_t n = 0U;
   Pose2 frame;
   double box[4];
@@ -277,7 +275,7 @@ void LoopClosure::search_pair(std::uint32_t older, std::uint32_t newer) {
   co.kernel_sigma_m = 1.5 * co.resolution_m;
   co.window_xy_m = options_.loop_search_window_m;
   co.window_theta_rad = options_.loop_search_window_rad;
-  co.min_score = options_.loop_search_confirm_score;  // search_continue() holds those below min_score
+  co.min_score = options_.loop_search_min_score;
   co.max_ambiguity = options_.loop_search_max_ambiguity;
   if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
     ++stats_->loop_search_failed;
@@ -319,31 +317,9 @@ void LoopClosure::search_continue() {
   }
   const Record lr =
       matched(search_pair_older_, search_a_, search_a_count_, search_pair_newer_, search_b_, search_b_count_, f, true);
-  // Held peaks this one agrees with are corroborated by it (whether it is held or not).
-  bool agreed = false;
-  std::uint32_t kept = 0U;
-  for (std::uint32_t k = 0; k < search_held_count_; ++k) {
-    if (agree(search_held_[k], lr)) {
-      ++stats_->loop_search_corroborated;
-      search_accept(search_held_[k]);
-      agreed = true;
-    } else {
-      search_held_[kept++] = search_held_[k];
-    }
-  }
-  search_held_count_ = kept;
-  const bool far = options_.loop_search_drift_m > 0.0 && moves_too_far(lr);
-  if (c.score < options_.loop_search_min_score || far) {
-    ++stats_->loop_search_held;
-    if (far) ++stats_->loop_search_far;
-    for (std::uint32_t k = 0; k < count_ && !agreed; ++k) {
-      agreed = records_[k].newer_level == lr.newer_level && agree(records_[k], lr);
-    }
-    if (!agreed) {
-      if (search_held_count_ < SdpOptions::kMaxLoopSearchCandidates) search_held_[search_held_count_++] = lr;
-      return;
-    }
-    ++stats_->loop_search_corroborated;
+  if (options_.loop_search_drift_m > 0.0 && moves_too_far(lr)) {
+    ++stats_->loop_search_far;
+    return;
   }
   search_accept(lr);
 }
@@ -352,32 +328,6 @@ void LoopClosure::search_accept(const Record& r) {
   ++stats_->loop_search_closed;
   record(r);
   if (!record_dead(r)) submaps_->on_verified_loop();  // the frames follow the new constraint now
-}
-
-// Two matches of the same newer submap against different older ones agree when the
-// older submaps are independent witnesses — their boxes, where the best combination's
-// frames put them now, share no area (two submaps of one corridor see the same walls,
-// and an aliased match against one repeats against the other) — and they place the
-// newer submap alike in that frame.
-bool LoopClosure::agree(const Record& a, const Record& b) const {
-  if (a.newer_level != b.newer_level || a.older_level == b.older_level) return false;
-  std::uint32_t n = 0U;
-  Pose2 fa;
-  Pose2 fb;
-  double ba[4];
-  double bb[4];
-  if (!submaps_->placement(a.older_level, &fa, ba, &n) || !submaps_->placement(b.older_level, &fb, bb, &n)) {
-    return false;
-  }
-  double ga[4];
-  double gb[4];
-  box_transform(fa, ba, ga);
-  box_transform(fb, bb, gb);
-  if (box_overlap_m2(ga, gb) > 0.0) return false;
-  const Pose2 d = between(fa.compose(a.z), fb.compose(b.z));
-  const double xy = options_.loop_search_confirm_xy_m;
-  const double th = normalize_angle_rad(d.heading_rad);
-  return d.x_m * d.x_m + d.y_m * d.y_m <= xy * xy && (th < 0.0 ? -th : th) <= options_.loop_search_confirm_rad;
 }
 
 // Whether r would move its newer submap (the centre of its box) farther from where the

@@ -92,15 +92,9 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("loop_search_window_rad", loop_search_window_rad, 0.0, 3.14159265358979323846);
   c.real("loop_search_min_score", loop_search_min_score, 1.0e-6, 1.0);
   c.real("loop_search_max_ambiguity", loop_search_max_ambiguity, 1.0e-6, 1.0);
-  c.real("loop_search_confirm_score", loop_search_confirm_score, 1.0e-6, 1.0);
-  c.real("loop_search_confirm_xy_m", loop_search_confirm_xy_m, 0.0, 10.0);
-  c.real("loop_search_confirm_rad", loop_search_confirm_rad, 0.0, 3.14159265358979323846);
   c.real("loop_search_drift_m", loop_search_drift_m, 0.0, 100.0);
   c.integer("loop_search_candidates", loop_search_candidates, 1U, kMaxLoopSearchCandidates);
   c.integer("loop_search_reads_per_scan", loop_search_reads_per_scan, 10000U, 1000000000U);
-  if (c.ok && loop_search_confirm_score > loop_search_min_score) {
-    c.fail("loop_search_confirm_score: above loop_search_min_score (a held peak must score less than a trusted one)");
-  }
   if (c.ok && !icp.valid()) c.fail("icp: options out of range (see icp2d.h Icp2dOptions::valid)");
   if (c.ok && loop_normal_radius_m > 100.0 * icp.nn_cell_m) {
     c.fail("loop_normal_radius_m: more than 100 icp nearest-neighbour cells (see Icp2d::direction_information)");

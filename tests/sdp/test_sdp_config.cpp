@@ -47,9 +47,6 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   DOUBLES_EQUAL(d.loop_search_window_rad, o.loop_search_window_rad, 0.0);
   DOUBLES_EQUAL(d.loop_search_min_score, o.loop_search_min_score, 0.0);
   DOUBLES_EQUAL(d.loop_search_max_ambiguity, o.loop_search_max_ambiguity, 0.0);
-  DOUBLES_EQUAL(d.loop_search_confirm_score, o.loop_search_confirm_score, 0.0);
-  DOUBLES_EQUAL(d.loop_search_confirm_xy_m, o.loop_search_confirm_xy_m, 0.0);
-  DOUBLES_EQUAL(d.loop_search_confirm_rad, o.loop_search_confirm_rad, 0.0);
   DOUBLES_EQUAL(d.loop_search_drift_m, o.loop_search_drift_m, 0.0);
   LONGS_EQUAL(d.permanent_map_tiles, o.permanent_map_tiles);
   LONGS_EQUAL(d.loop_search_candidates, o.loop_search_candidates);
@@ -158,18 +155,6 @@ TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
   CHECK_TRUE_TEXT(why.find("loop_search_window_m") != std::string::npos, why.c_str());
   CHECK(slam::apply_sdp_key(&o, "loop_search_min_score", "0", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "loop_search_candidates", "33", &why) == slam::SdpKeyResult::kInvalid);
-  // A held peak scores below a trusted one: confirm_score <= min_score, in either order.
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_score", "0.5", &why) == slam::SdpKeyResult::kInvalid);
-  CHECK_TRUE_TEXT(why.find("loop_search_confirm_score") != std::string::npos, why.c_str());
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_score", "0.45", &why) == slam::SdpKeyResult::kApplied);
-  CHECK(slam::apply_sdp_key(&o, "loop_search_min_score", "0.44", &why) == slam::SdpKeyResult::kInvalid);
-  CHECK_TRUE_TEXT(why.find("loop_search_confirm_score") != std::string::npos, why.c_str());
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_score", "0", &why) == slam::SdpKeyResult::kInvalid);
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_xy_m", "-0.1", &why) == slam::SdpKeyResult::kInvalid);
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_xy_m", "0.5", &why) == slam::SdpKeyResult::kApplied);
-  DOUBLES_EQUAL(0.5, o.loop_search_confirm_xy_m, 0.0);
-  CHECK(slam::apply_sdp_key(&o, "loop_search_confirm_rad", "4", &why) == slam::SdpKeyResult::kInvalid);
-  CHECK_TRUE_TEXT(why.find("loop_search_confirm_rad") != std::string::npos, why.c_str());
   CHECK(slam::apply_sdp_key(&o, "loop_search_drift_m", "-1", &why) == slam::SdpKeyResult::kInvalid);
   CHECK_TRUE_TEXT(why.find("loop_search_drift_m") != std::string::npos, why.c_str());
   CHECK(slam::apply_sdp_key(&o, "loop_search_drift_m", "0", &why) == slam::SdpKeyResult::kApplied);

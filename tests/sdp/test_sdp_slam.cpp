@@ -193,7 +193,7 @@ double permanent_map_agreement(const SdpSlam& slam, const test::ScanSet& set, co
 }
 
 // One run with the wide loop search; checks the PGS and that every search has exactly
-// one outcome (held peaks that no second pair corroborated are an outcome of their own).
+// one outcome.
 SdpStats run_loop_search(const test::ScanSet& set, const SdpOptions& o, double* error_m) {
   test::SdpRig r;
   CHECK_TRUE(r.init(test::sim_options(5), o, 21));
@@ -203,8 +203,7 @@ SdpStats run_loop_search(const test::ScanSet& set, const SdpOptions& o, double* 
   CHECK_TRUE(r.slam->graph().invariants_hold());
   const SdpStats st = r.slam->stats();
   LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
-                                    st.loop_search_refuted + st.loop_search_closed +
-                                    (st.loop_search_held - st.loop_search_corroborated));
+                                    st.loop_search_refuted + st.loop_search_closed + st.loop_search_far);
   return st;
 }
 }  // namespace
@@ -316,10 +315,9 @@ TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
     const SdpStats& st = b.slam->stats();
     CHECK(st.loop_searches > 0U);
     CHECK(st.loop_search_closed > 0U);
-    // Every search ends in exactly one outcome (a held peak nobody agreed with is its own).
+    // Every search ends in exactly one outcome.
     LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
-                                      st.loop_search_refuted + st.loop_search_closed +
-                                      (st.loop_search_held - st.loop_search_corroborated));
+                                      st.loop_search_refuted + st.loop_search_closed + st.loop_search_far);
     CHECK(st.loop_records_added > a.slam->stats().loop_records_added);
     CHECK_TRUE(b.slam->graph().invariants_hold());
     icp_only_m += mean_error_to_truth(ta, set) / 3.0;
@@ -333,64 +331,44 @@ TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
   CHECK(search_m < icp_only_m);
 }
 
-// A peak between loop_search_confirm_score and loop_search_min_score closes a loop only
-// when an older submap of another place (sharing no area with the first) places the same
-// newer one alike (test_loop_closure.cpp shows such a witness closing it). This world is
-// one room walked round: every older submap shares the room, so no second opinion is a
-// witness, and with min_score out of reach peaks are held and none closes; with the held
-// band empty nothing is held.
-TEST(SdpSlam, weak_search_peaks_close_loops_only_when_an_independent_older_submap_agrees) {
+// A peak below loop_search_min_score never closes a loop: with min_score out of reach
+// every search that found a peak ends weak.
+TEST(SdpSlam, search_peaks_below_the_minimum_score_close_no_loop) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
   s.loop_search_window_m = 3.0;
   s.loop_search_min_score = 1.0;
-  s.loop_search_confirm_score = 0.4;
-  auto run = [&](const SdpOptions& o, double* error_m) { return run_loop_search(set, o, error_m); };
-  const SdpStats a = run(s, nullptr);
-  CHECK(a.loop_search_held > 0U);
-  LONGS_EQUAL(0, a.loop_search_corroborated);
+  const SdpStats a = run_loop_search(set, s, nullptr);
+  CHECK(a.loop_search_weak > 0U);
   LONGS_EQUAL(0, a.loop_search_closed);
-  std::printf("\n  held search peaks: %llu held, none closed\n", static_cast<unsigned long long>(a.loop_search_held));
-  SdpOptions off = s;
-  off.loop_search_confirm_score = off.loop_search_min_score;
-  const SdpStats c = run(off, nullptr);
-  LONGS_EQUAL(0, c.loop_search_held);
-  LONGS_EQUAL(0, c.loop_search_corroborated);
+  LONGS_EQUAL(0, a.loop_search_far);
 }
 
 // A peak that would move its newer submap farther than the chain can have drifted
-// (loop_search_drift_m × √hops) is held like a weak one: with no drift allowed every
-// closure needs an independent older submap's agreement (none in this one-room world);
-// with the gate off nothing is held for its shift.
-TEST(SdpSlam, far_search_peaks_close_loops_only_when_an_independent_older_submap_agrees) {
+// (loop_search_drift_m × √hops) is refused: with no drift allowed no peak that moves its
+// submap closes; with the gate off none is refused for its shift.
+TEST(SdpSlam, far_search_peaks_are_refused) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
   s.loop_search_window_m = 3.0;
-  auto run = [&](const SdpOptions& o, double* error_m) {
-    const SdpStats st = run_loop_search(set, o, error_m);
-    CHECK(st.loop_search_far <= st.loop_search_held);
-    return st;
-  };
   SdpOptions none = s;
   none.loop_search_drift_m = 1.0e-9;
   double none_m = 0.0;
-  const SdpStats a = run(none, &none_m);
+  const SdpStats a = run_loop_search(set, none, &none_m);
   CHECK(a.loop_search_far > 0U);
-  LONGS_EQUAL(a.loop_search_corroborated, a.loop_search_closed);
   SdpOptions off = s;
   off.loop_search_drift_m = 0.0;
   double off_m = 0.0;
-  const SdpStats b = run(off, &off_m);
+  const SdpStats b = run_loop_search(set, off, &off_m);
   LONGS_EQUAL(0, b.loop_search_far);
-  CHECK(b.loop_search_closed > b.loop_search_corroborated);
+  CHECK(b.loop_search_closed > a.loop_search_closed);
   double default_m = 0.0;
-  const SdpStats c = run(s, &default_m);
-  std::printf("\n  far search peaks: %llu far of %llu held, mean position error %.3f m (no drift allowed %.3f m, "
-              "gate off %.3f m)\n",
-              static_cast<unsigned long long>(c.loop_search_far), static_cast<unsigned long long>(c.loop_search_held),
-              default_m, none_m, off_m);
+  const SdpStats c = run_loop_search(set, s, &default_m);
+  std::printf("\n  far search peaks: %llu refused, mean position error %.3f m (no drift allowed %.3f m, gate off "
+              "%.3f m)\n",
+              static_cast<unsigned long long>(c.loop_search_far), default_m, none_m, off_m);
 }
 
 // Worst-scan time: a skeleton patch is read from the DP map in strips of coarse rows

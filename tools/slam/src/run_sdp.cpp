@@ -227,9 +227,6 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "loop_search_window_rad") ok = real(&t.loop_search_window_rad);
   else if (key == "loop_search_min_score") ok = real(&t.loop_search_min_score);
   else if (key == "loop_search_max_ambiguity") ok = real(&t.loop_search_max_ambiguity);
-  else if (key == "loop_search_confirm_score") ok = real(&t.loop_search_confirm_score);
-  else if (key == "loop_search_confirm_xy_m") ok = real(&t.loop_search_confirm_xy_m);
-  else if (key == "loop_search_confirm_rad") ok = real(&t.loop_search_confirm_rad);
   else if (key == "loop_search_drift_m") ok = real(&t.loop_search_drift_m);
   else if (key == "loop_search_candidates") ok = integer(&t.loop_search_candidates);
   else if (key == "loop_search_reads_per_scan") ok = integer(&t.loop_search_reads_per_scan);

@@ -27,13 +27,13 @@
 // against up to loop_search_candidates older, non-adjacent submaps whose boxes (grown by
 // the window) overlap its own, exhaustively over ±loop_search_window_m and
 // ±loop_search_window_rad (correlative_matcher.h), in slices of
-// loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak that
-// obstacle ICP confirms becomes a constraint when it scores loop_search_min_score and
-// stays within the chain's drift (loop_search_drift_m × √hops); a weaker or farther one
-// is held until a second older submap, one that shares no area with the first (an
-// independent witness), places the newer one alike (loop_search_confirm_xy_m / _rad). A recorded search constraint asks the owner to
-// adjust at once (LoopSubmaps::on_verified_loop), so the next pair is judged against the
-// corrected frames.
+// loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak scoring
+// loop_search_min_score that obstacle ICP confirms becomes a constraint unless it would
+// move the newer submap farther than the chain can have drifted
+// (loop_search_drift_m × √hops); no peak is held for a second opinion (sdp_options.h
+// says why). A recorded search constraint asks the owner to adjust at once
+// (LoopSubmaps::on_verified_loop), so the next pair is judged against the corrected
+// frames.
 //
 // Memory: init() carves everything from the caller's Arena (required_bytes()); nothing
 // touches the heap afterwards. Deterministic: fixed order, no clocks.
@@ -61,14 +61,12 @@ struct LoopClosureStats {
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
-  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_confirm_score
+  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_min_score
   std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
   std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
   std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
-  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints (held ones included)
-  std::uint64_t loop_search_held = 0U;      // ... held for a second match (scoring confirm_score .. min_score, or far)
-  std::uint64_t loop_search_far = 0U;       // held ones that would move their submap beyond loop_search_drift_m × √hops
-  std::uint64_t loop_search_corroborated = 0U;  // held ones another pair agreed with (constraints now)
+  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints
+  std::uint64_t loop_search_far = 0U;       // ... refused: would move their submap beyond loop_search_drift_m × √hops
 };
 
 // The submaps loop closure works on: for each level the graph holds, the submap of the
@@ -162,7 +160,6 @@ class LoopClosure {
   void search_pair(std::uint32_t older_level, std::uint32_t newer_level);
   void search_continue();
   void search_accept(const Record& r);
-  bool agree(const Record& a, const Record& b) const;
   bool moves_too_far(const Record& r) const;
   std::uint32_t level_hops(std::uint32_t older_level, std::uint32_t newer_level) const;
 
@@ -186,9 +183,6 @@ class LoopClosure {
   std::uint32_t search_b_count_ = 0U;
   std::uint32_t search_pair_older_ = 0U;
   std::uint32_t search_pair_newer_ = 0U;
-  // Weak peaks of the level being searched, waiting for a second pair to agree.
-  Record search_held_[SdpOptions::kMaxLoopSearchCandidates] = {};
-  std::uint32_t search_held_count_ = 0U;
   std::uint32_t* hops_ = nullptr;  // max_nodes (level_hops() scratch)
   std::uint32_t max_nodes_ = 0U;
 };

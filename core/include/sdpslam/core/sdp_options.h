@@ -155,28 +155,17 @@ struct SdpOptions {
   double loop_search_window_rad = 0.6;         // [0, pi]
   double loop_search_min_score = 0.45;         // (0, 1]
   double loop_search_max_ambiguity = 0.9;      // (0, 1]
-  // A peak scoring at least loop_search_confirm_score but below loop_search_min_score
-  // (and passing the same ICP tests) is held, not trusted: it becomes a constraint only
-  // when another pair of the same newer submap places that submap the same way (within
-  // loop_search_confirm_xy_m and loop_search_confirm_rad in the best combination's
-  // frame): a second older submap, searched or already constrained to it, that shares
-  // no area with the first (their boxes in that frame do not overlap). Two false matches
-  // against submaps of different places seldom agree; against two submaps of one
-  // corridor they do (both see the same doors at the same pitch), so such a second
-  // opinion is no witness. A true loop seen weakly by each place it revisits does agree:
-  // a true loop seen only weakly still closes. Equal to loop_search_min_score: off.
-  double loop_search_confirm_score = 0.40;     // (0, loop_search_min_score]
-  double loop_search_confirm_xy_m = 0.30;      // [0, 10]
-  double loop_search_confirm_rad = 0.05;       // [0, pi]
-  // A lone peak (however well it scores) that would move the newer submap (its box
-  // centre, from where the best combination's frames put it now) farther than
-  // loop_search_drift_m × √hops is held the same way until a second older submap agrees;
-  // hops = the fewest steps between the two levels along the chain and the other loop
-  // constraints already recorded (the chain drifts like a random walk; a recorded loop is
-  // a short cut). Repeated structure (doors, pillars at a regular pitch) makes peaks that
-  // are metres off and, alone, would pull the map apart; a true loop's correction grows
-  // like the chain's random-walk drift, so a lone peak far beyond it waits for a second
-  // opinion. 0: off.
+  // A peak (however well it scores) that would move the newer submap (its box centre,
+  // from where the best combination's frames put it now) farther than
+  // loop_search_drift_m × √hops is refused; hops = the fewest steps between the two
+  // levels along the chain and the other loop constraints already recorded (the chain
+  // drifts like a random walk; a recorded loop is a short cut). Repeated structure
+  // (doors, pillars at a regular pitch) makes peaks that are metres off and would pull
+  // the map apart; a true loop's correction grows like the chain's random-walk drift.
+  // A refused or weak peak is not held for a second opinion from another older submap:
+  // the candidates all overlap the newer submap, so they overlap each other too and see
+  // the same repeated structure, and an aliased peak against one recurs against the
+  // next. 0: off.
   double loop_search_drift_m = 2.0;            // [0, 100]
   // Older submaps searched per level, largest overlaps first. A place revisited after a
   // long loop overlaps many older submaps (a corridor walked several times, rooms along
