@@ -6,6 +6,7 @@
 // refined and kept one per pair of levels, the best residual winning; a full store makes
 // room with a record whose levels are gone; nothing is searched without a window.
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "CppUTest/TestHarness.h"
