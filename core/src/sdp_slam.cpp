@@ -212,7 +212,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
       return false;
     }
     if (live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr || obst_b_ == nullptr ||
-        !loop_closure_.init(s, graph_nodes(s), search_geometry(b, s), icp_, this, &stats_, arena)) {
+        !loop_closure_.init(s, graph_nodes(s), search_geometry(b, s), icp_, &loop_view_, &stats_, arena)) {
       std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");
       return false;
     }

@@ -165,7 +165,7 @@ class SdpPathSink {
   ~SdpPathSink() = default;
 };
 
-class SdpSlam final : private LoopSubmaps {
+class SdpSlam {
  public:
   SdpSlam() = default;
   SdpSlam(const SdpSlam&) = delete;
@@ -375,15 +375,29 @@ class SdpSlam final : private LoopSubmaps {
   // live); false if the level is no longer held.
   bool level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
                        double box[4]) const;
-  // LoopSubmaps: the best combination's submaps, as loop closure sees them.
-  bool node_index(std::uint32_t level, std::uint32_t* index) const override { return graph_index(level, index); }
-  std::uint32_t node_count() const override { return perm_count_ + graph_.live_level_count(); }
-  std::uint32_t first_held_level() const override;
-  std::uint32_t first_live_level() const override { return graph_.first_live_level(); }
-  std::uint32_t level_end() const override { return graph_.level_end(); }
-  bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const override;
-  void obstacles(std::uint32_t level, Point2* out) const override;
-  void on_verified_loop() override { update_best(); }
+  // The best combination's submaps, as loop closure sees them (LoopView).
+  std::uint32_t first_held_level() const;
+  bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const;
+  void obstacles(std::uint32_t level, Point2* out) const;
+  // LoopSubmaps for LoopClosure, kept a member (as RingSink) so that SdpSlam itself has no
+  // virtual functions.
+  class LoopView final : public LoopSubmaps {
+   public:
+    explicit LoopView(SdpSlam& owner) : owner_(owner) {}
+    bool node_index(std::uint32_t level, std::uint32_t* index) const override { return owner_.graph_index(level, index); }
+    std::uint32_t node_count() const override { return owner_.perm_count_ + owner_.graph_.live_level_count(); }
+    std::uint32_t first_held_level() const override { return owner_.first_held_level(); }
+    std::uint32_t first_live_level() const override { return owner_.graph_.first_live_level(); }
+    std::uint32_t level_end() const override { return owner_.graph_.level_end(); }
+    bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* count) const override {
+      return owner_.placement(level, frame, box, count);
+    }
+    void obstacles(std::uint32_t level, Point2* out) const override { owner_.obstacles(level, out); }
+    void on_verified_loop() override { owner_.update_best(); }
+
+   private:
+    SdpSlam& owner_;
+  };
 
   SdpOptions options_{};
   DpSlamOptions bottom_options_{};
@@ -431,6 +445,7 @@ class SdpSlam final : private LoopSubmaps {
   Point2* obst_a_ = nullptr;        // loop_points (scratch)
   Point2* obst_b_ = nullptr;
   LoopClosure loop_closure_;
+  LoopView loop_view_{*this};
   // Submaps of a permanent level waiting to be released, one per call of process()
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N
