@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -18,6 +19,10 @@ enum ExitCode : int {
   kExitBadInput = 3,   // unreadable, malformed or inconsistent input data
   kExitIo = 4,         // an output could not be written
 };
+
+// Skipped log lines named on stderr, of each kind (malformed, skipped on purpose), before
+// the rest are only counted (io::write_log_errors).
+inline constexpr std::size_t kLogErrorsShown = 20U;
 
 // A subcommand: `setup` adds options to its CLI::App and returns the function that runs
 // it after parsing (the function returns an ExitCode).

@@ -78,10 +78,7 @@ int run_convert(const ConvertArgs& a) {
   }
   progress.finish();
 
-  for (const io::LogError& e : reader.errors()) std::fprintf(stderr, "%s\n", e.to_string().c_str());
-  if (reader.error_count() > reader.errors().size()) {
-    std::fprintf(stderr, "... and %zu more skipped lines\n", reader.error_count() - reader.errors().size());
-  }
+  io::write_log_errors(stderr, reader.errors(), reader.error_count(), kLogErrorsShown);
   if (!writer.close(&error)) {
     std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
     return kExitIo;

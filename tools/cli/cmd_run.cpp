@@ -73,6 +73,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   slam::SdpRunSummary s;
   switch (slam::run_sdp_offline(a.log, ro, a.out, &s, &error)) {
     case slam::SdpRunStatus::kOk:
+      io::write_log_errors(stderr, s.log_errors, s.log_error_count, kLogErrorsShown);
       std::fprintf(stderr,
                    "sdpslam run: %llu scans (%llu processed, %llu segments) in %.1f s, %zu log errors; ICP error "
                    "%.3f +- %.3f m over %llu samples; outputs in %s\n",
@@ -100,6 +101,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   const slam::RunStatus st = slam::run_offline(a.log, ro, a.out, &summary, &error);
   switch (st) {
     case slam::RunStatus::kOk:
+      io::write_log_errors(stderr, summary.log_errors, summary.log_error_count, kLogErrorsShown);
       std::fprintf(stderr, "sdpslam run: %llu scans (%llu processed) in %.1f s, %zu log errors; outputs in %s\n",
                    static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
                    summary.wall_time_s, summary.log_error_count, a.out.c_str());

@@ -1,3 +1,4 @@
+#include <cstdio>
 #include <string>
 
 #include "sdpslam/io/log_reader.h"
@@ -15,5 +16,18 @@ const char* to_string(LogFormat f) {
 }
 
 std::string LogError::to_string() const { return file + ":" + std::to_string(line) + ": " + reason; }
+
+void write_log_errors(std::FILE* out, const std::vector<LogError>& errors, std::size_t total, std::size_t max_each) {
+  std::size_t shown_errors = 0U;
+  std::size_t shown_warnings = 0U;
+  for (const LogError& e : errors) {
+    std::size_t& shown = e.warning ? shown_warnings : shown_errors;
+    if (shown >= max_each) continue;
+    ++shown;
+    std::fprintf(out, "%s\n", e.to_string().c_str());
+  }
+  const std::size_t shown = shown_errors + shown_warnings;
+  if (total > shown) std::fprintf(out, "... and %zu more skipped lines\n", total - shown);
+}
 
 }  // namespace sdpslam::io

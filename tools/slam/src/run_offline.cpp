@@ -148,6 +148,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     summary->scans = scans.size();
     summary->processed = st.processed;
     summary->log_error_count = reader.error_count();
+    summary->log_errors = reader.errors();
     summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
     summary->wall_time_s = wall_s;
   }

@@ -393,6 +393,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->processed = bs.processed;
     summary->segments = st.segments;
     summary->log_error_count = reader.error_count();
+    summary->log_errors = reader.errors();
     summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
     summary->wall_time_s = wall_s;
     summary->icp_error_mean_m = st.error_mean_m();

@@ -8,6 +8,7 @@
 // delivered. Nothing is silently misread: a line either parses completely and passes
 // its consistency checks, or it is an error.
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,12 @@ struct LogError {
   bool warning = false;
   std::string to_string() const;  // "file:line: reason"
 };
+
+// Writes the skipped lines to `out`, one "file:line: reason" each: the first max_each
+// malformed lines and the first max_each warnings (lines skipped on purpose), then
+// "... and N more skipped lines" for the rest of `total` (every skipped line, of which
+// `errors` holds the first ones). Every command that reads a log reports this way.
+void write_log_errors(std::FILE* out, const std::vector<LogError>& errors, std::size_t total, std::size_t max_each);
 
 // A laser scan with everything the log says about it.
 struct LaserRecord {

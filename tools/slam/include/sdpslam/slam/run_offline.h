@@ -14,6 +14,7 @@
 // All files are written atomically.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sdpslam/slam/config_ini.h"
 
@@ -32,6 +33,7 @@ struct RunSummary {
   std::uint64_t scans = 0U;
   std::uint64_t processed = 0U;
   std::size_t log_error_count = 0U;
+  std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
   std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
   double wall_time_s = 0.0;
 };

@@ -21,6 +21,7 @@
 // Same log, options and seed -> bit-identical trajectory.txt, map and icp_error.csv.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/sdp_profile.h"
@@ -43,6 +44,7 @@ struct SdpRunSummary {
   std::uint64_t processed = 0U;
   std::uint64_t segments = 0U;
   std::size_t log_error_count = 0U;
+  std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
   std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
   double wall_time_s = 0.0;
   double icp_error_mean_m = 0.0;

@@ -1,0 +1,104 @@
+// `sdpslam run` end to end on small logs with bad lines: every skipped line is named
+// with file:line and its reason (the first kLogErrorsShown of each kind), the rest are
+// counted, and the good scans still make a trajectory.
+#include <CppUTest/TestHarness.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "sdpslam/io/atomic_file.h"
+#include "shared_data.h"
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out;  // stdout and stderr together
+};
+
+Run run_cli(const std::string& args) {
+  Run r;
+  const std::string cmd = std::string(SDPSLAM_CLI_PATH) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::size_t lines_in(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t n = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line[0] != '#') ++n;
+  }
+  return n;
+}
+
+// One FLASER line of 180 beams 2 m long, the robot at x (m), stamped t (s).
+std::string scan(double x, double t, const char* bad_range = nullptr) {
+  std::string s = "FLASER 180";
+  for (int i = 0; i < 180; ++i) s += (i == 7 && bad_range != nullptr) ? std::string(" ") + bad_range : " 2.0";
+  char tail[160];
+  std::snprintf(tail, sizeof tail, " %.3f 0 0 %.3f 0 0 %.6f host %.6f\n", x, x, t, t);
+  return s + tail;
+}
+
+}  // namespace
+
+TEST_GROUP(CliRun) {
+  std::string dir;
+  void setup() override { dir = sdpslam::test::make_temp_dir("cli-run"); }
+  void teardown() override {
+    const std::string cmd = "rm -rf '" + dir + "'";
+    CHECK_EQUAL(0, std::system(cmd.c_str()));
+  }
+  std::string put(const char* name, const std::string& text) {
+    std::string error;
+    const std::string p = dir + "/" + name;
+    CHECK_TRUE(sdpslam::io::write_file_atomic(p, text, &error));
+    return p;
+  }
+  // Ten good scans, then `bad` scans with a NaN range, then an unknown message type.
+  std::string log_with_bad_lines(int bad) {
+    std::string text;
+    for (int i = 0; i < 10; ++i) text += scan(0.05 * i, 100.0 + 0.1 * i);
+    for (int i = 0; i < bad; ++i) text += scan(0.5, 101.0 + 0.1 * i, "nan");
+    text += "NOSUCHSENSOR 1 2 3\n";
+    return put("log.clf", text);
+  }
+};
+
+TEST(CliRun, every_skipped_line_is_named_in_both_modes) {
+  const std::string log = log_with_bad_lines(2);
+  for (const char* mode : {"sdp", "dpslam"}) {
+    const Run r = run_cli("run " + log + " --mode " + mode + " --out " + dir + "/out");
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    STRCMP_CONTAINS((log + ":11: range 7 (field 10) is not a finite number").c_str(), r.out.c_str());
+    STRCMP_CONTAINS((log + ":12: range 7").c_str(), r.out.c_str());
+    STRCMP_CONTAINS((log + ":13: unknown message type").c_str(), r.out.c_str());
+    CHECK_TEXT(r.out.find("more skipped lines") == std::string::npos, r.out.c_str());
+    STRCMP_CONTAINS("3 log errors", r.out.c_str());
+    // The good scans are all in the trajectory.
+    LONGS_EQUAL_TEXT(10, lines_in(dir + "/out/trajectory.txt"), mode);
+  }
+}
+
+TEST(CliRun, past_the_first_lines_of_a_kind_the_rest_are_counted) {
+  const std::string log = log_with_bad_lines(25);
+  const Run r = run_cli("run " + log + " --mode dpslam --out " + dir + "/out");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS((log + ":30: range 7").c_str(), r.out.c_str());  // the 20th malformed line
+  CHECK_TEXT(r.out.find(log + ":31: ") == std::string::npos, r.out.c_str());
+  STRCMP_CONTAINS((log + ":36: unknown message type").c_str(), r.out.c_str());  // its own kind
+  STRCMP_CONTAINS("... and 5 more skipped lines", r.out.c_str());
+  STRCMP_CONTAINS("26 log errors", r.out.c_str());
+}
