@@ -102,3 +102,38 @@ TEST(CliRun, past_the_first_lines_of_a_kind_the_rest_are_counted) {
   STRCMP_CONTAINS("... and 5 more skipped lines", r.out.c_str());
   STRCMP_CONTAINS("26 log errors", r.out.c_str());
 }
+
+// The hostile case: a 1 km odometry jump. The line is named, the jump is not
+// applied (the trajectory moves centimetres, not a kilometre), stats.json counts it; a
+// scan stamped before the one it follows is reported with its line.
+TEST(CliRun, an_odometry_jump_and_time_going_backwards_are_reported_and_handled) {
+  std::string text;
+  for (int i = 0; i < 10; ++i) text += scan(0.05 * i, 100.0 + 0.1 * i);
+  text += scan(1000.5, 101.0);                 // line 11: 1 km in 0.1 s
+  for (int i = 1; i < 5; ++i) text += scan(1000.5 + 0.05 * i, 101.0 + 0.1 * i);
+  text += scan(1000.75, 101.35);               // line 16: before 101.4
+  const std::string log = put("log.clf", text);
+  for (const char* mode : {"sdp", "dpslam"}) {
+    const Run r = run_cli("run " + log + " --mode " + mode + " --out " + dir + "/out");
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    STRCMP_CONTAINS((log + ":11: odometry jumps 1000.050 m").c_str(), r.out.c_str());
+    STRCMP_CONTAINS("1 odometry increments beyond the plausible speed", r.out.c_str());
+    STRCMP_CONTAINS(("1 scans are stamped before the scan they follow (the first at " + log + ":16)").c_str(),
+                    r.out.c_str());
+    std::ifstream in(dir + "/out/trajectory.txt");
+    std::string line;
+    double max_x = 0.0;
+    while (std::getline(in, line)) {
+      double t = 0.0, x = 0.0, y = 0.0, th = 0.0;
+      if (!line.empty() && line[0] != '#' && std::sscanf(line.c_str(), "%lf %lf %lf %lf", &t, &x, &y, &th) == 4) {
+        if (x > max_x) max_x = x;
+      }
+    }
+    CHECK_TEXT(max_x < 2.0, mode);
+    std::ifstream js(dir + "/out/stats.json");
+    std::stringstream ss;
+    ss << js.rdbuf();
+    STRCMP_CONTAINS("\"odometry_jumps_removed\": 1", ss.str().c_str());
+    STRCMP_CONTAINS("\"scans_stamped_backwards\": 1", ss.str().c_str());
+  }
+}

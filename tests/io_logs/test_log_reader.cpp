@@ -19,7 +19,16 @@ using sdpslam::test::tinyslam_line;
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 
-LogContents read_all(const std::string& path, const LogReaderOptions& o = LogReaderOptions{}) {
+// These crafted logs move metres in microseconds: the odometry plausibility checks are
+// off except in the tests that are about them.
+LogReaderOptions unchecked() {
+  LogReaderOptions o;
+  o.max_speed_mps = 0.0;
+  o.max_turn_rate_radps = 0.0;
+  return o;
+}
+
+LogContents read_all(const std::string& path, const LogReaderOptions& o = unchecked()) {
   LogContents c;
   std::string error;
   CHECK_TEXT(sdpslam::io::read_whole_log(path, o, &c, &error), error.c_str());
@@ -155,7 +164,7 @@ TEST(LogReader, truncated_gzip_is_reported_after_the_records_before_the_cut) {
   const std::string cut = dir.write("cut.clf.gz", bytes.substr(0, bytes.size() / 2));
   LogContents c;
   std::string error;
-  CHECK(sdpslam::io::read_whole_log(cut, LogReaderOptions{}, &c, &error));
+  CHECK(sdpslam::io::read_whole_log(cut, unchecked(), &c, &error));
   CHECK(c.odoms.size() > 0U);
   CHECK(c.odoms.size() < 2000U);
   CHECK(c.error_count >= 1U);
@@ -254,7 +263,7 @@ TEST(LogReader, tinyslam_right_wheel_ahead_turns_left) {
 
 TEST(LogReader, tinyslam_wheel_params_come_from_options) {
   ScratchDir dir("io-tiny-params");
-  LogReaderOptions o;
+  LogReaderOptions o = unchecked();
   o.wheels.ticks_per_rev = 1000.0;
   o.wheels.wheel_radius_m = 0.1;
   std::string s = tinyslam_line(1, 0, 0, 1000) + "\n" + tinyslam_line(2, 1000, 1000, 1000) + "\n";
@@ -339,7 +348,7 @@ TEST(LogReader, odometry_advancing_against_a_negative_velocity_is_mirrored) {
   const std::string path = dir.write("rev.clf", s);
   LogReader reader;
   std::string error;
-  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  CHECK_TEXT(reader.open(path, unchecked(), &error), error.c_str());
   std::vector<sdpslam::Pose2> odoms;
   std::vector<sdpslam::Pose2> lasers;
   for (LogReader::Next n = reader.next(); n != LogReader::Next::kEnd; n = reader.next()) {
@@ -384,7 +393,7 @@ TEST(LogReader, self_consistent_odometry_is_returned_as_written) {
   const std::string path = dir.write("ok.clf", s);
   LogReader reader;
   std::string error;
-  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  CHECK_TEXT(reader.open(path, unchecked(), &error), error.c_str());
   while (reader.next() != LogReader::Next::kEnd) {
   }
   CHECK_EQUAL(0U, reader.odometry_reversals_repaired());
@@ -397,4 +406,80 @@ TEST(LogReader, self_consistent_odometry_is_returned_as_written) {
   CHECK_EQUAL(1.1, c.odoms[2].pose.x_m);
   CHECK_EQUAL(1.2, c.lasers[0].odom_pose.x_m);
   CHECK_EQUAL(0.95, c.lasers[0].laser_pose.y_m);
+}
+
+// A 1 km odometry jump in 0.1 s (a reset, or a corrupt line) is no motion a wheeled
+// robot makes: it is named and not applied; the increments after it are kept as written
+// on the chain from the pose before it, for ODOM and the lasers' odometry alike.
+TEST(LogReader, an_impossible_odometry_jump_is_named_and_not_applied) {
+  ScratchDir dir("io-jump");
+  std::string s;
+  s += odom_tv("0 0 0", "0.5", "100.0") + "\n";
+  s += flaser_line(3, "1.0", "0.05 0 0", "100.05") + "\n";
+  s += odom_tv("0.1 0 0", "0.5", "100.1") + "\n";
+  s += odom_tv("1000.1 0 0", "0.5", "100.2") + "\n";               // line 4: the jump
+  s += flaser_line(3, "1.0", "1000.15 0 0", "100.25") + "\n";      // on the jumped chain: follows
+  s += odom_tv("1000.2 0 0.05", "0.5", "100.3") + "\n";
+  const std::string path = dir.write("jump.clf", s);
+  LogReader reader;
+  std::string error;
+  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  std::vector<sdpslam::Pose2> odoms;
+  std::vector<sdpslam::Pose2> lasers;
+  for (LogReader::Next n = reader.next(); n != LogReader::Next::kEnd; n = reader.next()) {
+    if (n == LogReader::Next::kOdom) odoms.push_back(reader.odom().pose);
+    if (n == LogReader::Next::kLaser) lasers.push_back(reader.laser().odom_pose);
+  }
+  CHECK_EQUAL(1U, reader.odometry_jumps_removed());
+  CHECK_EQUAL(1U, reader.error_count());
+  CHECK_EQUAL(4, reader.errors()[0].line);
+  STRCMP_CONTAINS("odometry jumps 1000.000 m", reader.errors()[0].reason.c_str());
+  STRCMP_CONTAINS("not applied", reader.errors()[0].reason.c_str());
+  CHECK_EQUAL(4U, odoms.size());
+  CHECK_EQUAL(2U, lasers.size());
+  DOUBLES_EQUAL(0.1, odoms[2].x_m, 1e-9);   // the jump: no motion
+  DOUBLES_EQUAL(0.15, lasers[1].x_m, 1e-9);  // later poses keep their increments
+  DOUBLES_EQUAL(0.2, odoms[3].x_m, 1e-9);
+  DOUBLES_EQUAL(0.05, odoms[3].heading_rad, 1e-12);
+}
+
+// Fast but possible motion (2 m/s and a 3 rad/s turn at 10 Hz), a turn on the spot and a
+// three-second gap with its motion are not jumps: poses as written.
+TEST(LogReader, fast_plausible_motion_is_not_a_jump) {
+  ScratchDir dir("io-fast");
+  std::string s;
+  s += odom_tv("0 0 0", "2", "100.0") + "\n";
+  s += odom_tv("0.2 0 0.3", "2", "100.1") + "\n";
+  s += odom_tv("0.2 0 1.8", "0", "100.6") + "\n";
+  s += odom_tv("0.2 0 0", "0", "101.1") + "\n";
+  s += odom_tv("6.2 0 0", "2", "104.1") + "\n";
+  const LogContents c = read_all(dir.write("fast.clf", s), LogReaderOptions{});
+  CHECK_EQUAL(0U, c.error_count);
+  CHECK_EQUAL(5U, c.odoms.size());
+  DOUBLES_EQUAL(1.8, c.odoms[2].pose.heading_rad, 0.0);
+  DOUBLES_EQUAL(6.2, c.odoms[4].pose.x_m, 0.0);
+}
+
+// Scans stamped before the scan they follow are counted with the first one's line and
+// returned in file order, stamps as written (the order the laser delivered them).
+TEST(LogReader, scans_stamped_backwards_are_counted_and_kept_in_file_order) {
+  ScratchDir dir("io-backwards");
+  std::string s;
+  s += flaser_line(3, "1.0", "0 0 0", "100.0") + "\n";
+  s += flaser_line(3, "1.0", "0.1 0 0", "100.7") + "\n";  // a stamp ahead of its time
+  s += flaser_line(3, "1.0", "0.2 0 0", "100.2") + "\n";  // line 3: before 100.7
+  s += flaser_line(3, "1.0", "0.3 0 0", "100.3") + "\n";
+  const std::string path = dir.write("back.clf", s);
+  LogReader reader;
+  std::string error;
+  CHECK_TEXT(reader.open(path, LogReaderOptions{}, &error), error.c_str());
+  std::vector<std::int64_t> stamps;
+  for (LogReader::Next n = reader.next(); n != LogReader::Next::kEnd; n = reader.next()) {
+    if (n == LogReader::Next::kLaser) stamps.push_back(reader.laser().stamp_us);
+  }
+  CHECK_EQUAL(1U, reader.scans_stamped_backwards());
+  CHECK_EQUAL(3, reader.first_backwards_line());
+  CHECK_EQUAL(0U, reader.error_count());
+  CHECK_EQUAL(4U, stamps.size());
+  CHECK_EQUAL(100200000, stamps[2]);
 }

@@ -46,6 +46,22 @@ void report_odometry_repairs(std::size_t repaired) {
                repaired);
 }
 
+// Impossible input the reader handled by its documented rules (io::LogReader::next()).
+void report_implausible(std::size_t jumps, std::size_t backwards, const std::string& first_backwards_at) {
+  if (jumps > 0U) {
+    std::fprintf(stderr,
+                 "sdpslam run: %zu odometry increments beyond the plausible speed or turn rate ([log] max_speed_mps, "
+                 "max_turn_rate_radps) were not applied (named above)\n",
+                 jumps);
+  }
+  if (backwards > 0U) {
+    std::fprintf(stderr,
+                 "sdpslam run: %zu scans are stamped before the scan they follow (the first at %s); processed in file "
+                 "order, stamps as written\n",
+                 backwards, first_backwards_at.c_str());
+  }
+}
+
 // `config` holds the profile's bottom-level options with the file's keys on top; `sdp`
 // the profile's top-level options, the file's [sdp] keys go on top of them here.
 int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOptions& sdp, SdpProfile profile) {
@@ -81,6 +97,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
                    static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
                    s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
       report_odometry_repairs(s.odometry_reversals_repaired);
+      report_implausible(s.odometry_jumps_removed, s.scans_stamped_backwards, s.first_backwards_at);
       return kExitOk;
     case slam::SdpRunStatus::kBadInput: return report("", kExitBadInput, error);
     case slam::SdpRunStatus::kIoError: return report("", kExitIo, error);
@@ -106,6 +123,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
                    static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
                    summary.wall_time_s, summary.log_error_count, a.out.c_str());
       report_odometry_repairs(summary.odometry_reversals_repaired);
+      report_implausible(summary.odometry_jumps_removed, summary.scans_stamped_backwards, summary.first_backwards_at);
       return kExitOk;
     case slam::RunStatus::kBadInput: return report("", kExitBadInput, error);
     case slam::RunStatus::kIoError: return report("", kExitIo, error);

@@ -4,6 +4,8 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -12,6 +14,7 @@
 #include "carmen_parse.h"
 #include "log_parse.h"
 #include "sdpslam/io/log_reader.h"
+#include "sdpslam/core/det_math.h"
 
 namespace sdpslam::io {
 namespace {
@@ -186,6 +189,86 @@ struct LogReader::Impl {
   Pose2 repair_last_raw;
   Pose2 repair_last_pose;
   std::size_t repairs = 0;
+
+  // Plausibility (LogReader::next()), per message type (ODOM, FLASER and the other
+  // front lasers, RLASER, ROBOTLASER1): types interleave with stamps of their own
+  // sources, and a laser line may carry an odometry pose older than its stamp.
+  struct TypeState {
+    std::int64_t last_stamp_us = 0;
+    bool latched_stamp = false;
+    bool latched = false;
+    Pose2 last_pose;  // the last odometry pose returned for this type
+  };
+  TypeState types[4];
+  Pose2 jump_offset;  // odometry returned = jump_offset ∘ odometry as written
+  std::size_t jumps_removed = 0;
+  std::size_t stamps_backwards = 0;
+  std::int64_t first_backwards_line = 0;
+
+  TypeState& type_of(Next got) {
+    if (got == Next::kOdom) return types[0];
+    if (laser.keyword == "RLASER") return types[2];
+    if (laser.keyword == "ROBOTLASER1") return types[3];
+    return types[1];
+  }
+
+  // Counts a laser whose stamp is before the previous one of its type (the log is
+  // processed in file order, the order its sensors delivered; trajectories keep the
+  // stamps as written).
+  void check_stamp_order(Next got) {
+    if (got != Next::kLaser || !laser.has_stamp) return;
+    const TypeState& t = type_of(got);
+    if (t.latched_stamp && laser.stamp_us < t.last_stamp_us) {
+      if (stamps_backwards == 0U) first_backwards_line = line_no;
+      ++stamps_backwards;
+    }
+  }
+
+  // The odometry pose of a record on the chain without impossible jumps; reports one.
+  Pose2 plausible(TypeState& t, const Pose2& written, std::int64_t stamp_us, bool has_stamp) {
+    Pose2 out = jump_offset.compose(written);
+    if (t.latched && t.latched_stamp && has_stamp) {
+      const std::int64_t gap_us = stamp_us > t.last_stamp_us ? stamp_us - t.last_stamp_us : t.last_stamp_us - stamp_us;
+      const double dt_s = static_cast<double>(gap_us) * 1e-6;
+      const Pose2 d = between(t.last_pose, out);
+      const double dist_m = det::sqrt(d.x_m * d.x_m + d.y_m * d.y_m);
+      const double turn_rad = d.heading_rad < 0.0 ? -d.heading_rad : d.heading_rad;
+      constexpr double kSlackM = 0.5;
+      constexpr double kSlackRad = 0.5;
+      const bool too_fast = options.max_speed_mps > 0.0 && dist_m > options.max_speed_mps * dt_s + kSlackM;
+      const bool turns_too_fast =
+          options.max_turn_rate_radps > 0.0 && turn_rad > options.max_turn_rate_radps * dt_s + kSlackRad;
+      if (too_fast || turns_too_fast) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "odometry jumps %.3f m and %.3f rad in %.3f s (limits %.3g m/s, %.3g rad/s): not applied",
+                      dist_m, turn_rad, dt_s, options.max_speed_mps, options.max_turn_rate_radps);
+        add_error(line_no, text, false);
+        ++jumps_removed;
+        jump_offset = t.last_pose.compose(written.inverse());
+        out = t.last_pose;
+      }
+    }
+    t.latched = true;
+    t.last_pose = out;
+    return out;
+  }
+  void stamped(TypeState& t, std::int64_t stamp_us, bool has_stamp) {
+    if (!has_stamp) return;
+    t.last_stamp_us = stamp_us;
+    t.latched_stamp = true;
+  }
+  void plausible_record(Next got) {
+    if (got == Next::kOdom) {
+      odom.pose = plausible(types[0], odom.pose, odom.stamp_us, true);
+      stamped(types[0], odom.stamp_us, true);
+      return;
+    }
+    if (got != Next::kLaser || !laser.has_odom_pose) return;
+    const Pose2 written = laser.odom_pose;
+    laser.odom_pose = plausible(type_of(got), written, laser.stamp_us, laser.has_stamp);
+    if (laser.has_laser_pose) laser.laser_pose = laser.odom_pose.compose(between(written, laser.laser_pose));
+  }
 
   // The increment's forward component, from the raw coordinate differences: exactly 0
   // when the position did not change (an in-place turn), where between()'s rotation
@@ -468,7 +551,10 @@ LogReader::Next LogReader::next() {
       continue;
     }
     if (got == Next::kEnd) continue;  // an ignored message type
+    s.check_stamp_order(got);
     if (s.format == LogFormat::kCarmen) s.repair_record(got);
+    s.plausible_record(got);
+    if (got == Next::kLaser) s.stamped(s.type_of(got), s.laser.stamp_us, s.laser.has_stamp);
     switch (got) {
       case Next::kLaser: s.laser.line = s.line_no; break;
       case Next::kOdom: s.odom.line = s.line_no; break;
@@ -495,6 +581,9 @@ const std::vector<LogError>& LogReader::errors() const { return impl_->errors; }
 std::size_t LogReader::error_count() const { return impl_->error_count; }
 std::size_t LogReader::warning_count() const { return impl_->warning_count; }
 std::size_t LogReader::odometry_reversals_repaired() const { return impl_->repairs; }
+std::size_t LogReader::odometry_jumps_removed() const { return impl_->jumps_removed; }
+std::size_t LogReader::scans_stamped_backwards() const { return impl_->stamps_backwards; }
+std::int64_t LogReader::first_backwards_line() const { return impl_->first_backwards_line; }
 std::int64_t LogReader::lines_read() const { return impl_->line_no; }
 std::uint64_t LogReader::input_offset() const { return impl_->source.offset(); }
 

@@ -167,6 +167,15 @@ ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, con
                                  const char* value, std::string* why) {
   if (!is_slam_config_section(sec)) return ConfigKeyResult::kUnknown;
   if (sec == "log") {
+    if (key == "max_speed_mps" || key == "max_turn_rate_radps") {
+      double v = 0.0;
+      if (parse_real(value, &v) && v >= 0.0 && v <= 1000.0) {
+        (key == "max_speed_mps" ? config->log.max_speed_mps : config->log.max_turn_rate_radps) = v;
+        return ConfigKeyResult::kApplied;
+      }
+      *why = "log." + key + ": '" + std::string(value) + "' out of range [0, 1000] (0 = not checked)";
+      return ConfigKeyResult::kInvalid;
+    }
     if (key != "default_range_max_m") return ConfigKeyResult::kUnknown;
     double r = 0.0;
     if (parse_real(value, &r) && r > 0.0 && r <= 1000.0) {

@@ -119,6 +119,8 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
   js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
+  js += "  \"odometry_jumps_removed\": " + u(reader.odometry_jumps_removed()) + ",\n";
+  js += "  \"scans_stamped_backwards\": " + u(reader.scans_stamped_backwards()) + ",\n";
   js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
   js += "  \"proposal\": {\"matched\": " + u(st.proposal_matched) + ", \"fallback_few_beams\": " +
         u(st.proposal_fallback_few_beams) + ", \"fallback_empty_map\": " + u(st.proposal_fallback_empty_map) +
@@ -150,6 +152,11 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     summary->log_error_count = reader.error_count();
     summary->log_errors = reader.errors();
     summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
+    summary->odometry_jumps_removed = reader.odometry_jumps_removed();
+    summary->scans_stamped_backwards = reader.scans_stamped_backwards();
+    if (reader.scans_stamped_backwards() > 0U) {
+      summary->first_backwards_at = log_path + ":" + std::to_string(reader.first_backwards_line());
+    }
     summary->wall_time_s = wall_s;
   }
   return RunStatus::kOk;

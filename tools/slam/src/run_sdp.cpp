@@ -370,6 +370,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
   js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
   js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
+  js += "  \"odometry_jumps_removed\": " + u(reader.odometry_jumps_removed()) + ",\n";
+  js += "  \"scans_stamped_backwards\": " + u(reader.scans_stamped_backwards()) + ",\n";
   js += sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells);
   js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
         fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
@@ -395,6 +397,11 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->log_error_count = reader.error_count();
     summary->log_errors = reader.errors();
     summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
+    summary->odometry_jumps_removed = reader.odometry_jumps_removed();
+    summary->scans_stamped_backwards = reader.scans_stamped_backwards();
+    if (reader.scans_stamped_backwards() > 0U) {
+      summary->first_backwards_at = log_path + ":" + std::to_string(reader.first_backwards_line());
+    }
     summary->wall_time_s = wall_s;
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();

@@ -102,6 +102,14 @@ struct LogReaderOptions {
   // tinySLAM: the URG's forward offset from the wheel axle (BreezySLAM examples/mines.py,
   // MinesLaser: 145 mm).
   double tinyslam_laser_offset_m = 0.145;
+  // Plausibility of the odometry ([log] keys): an increment between two consecutive
+  // odometry poses (ODOM and the lasers' odometry poses, in file order) that moves
+  // farther than max_speed_mps × Δt + 0.5 m, or turns more than max_turn_rate_radps ×
+  // Δt + 0.5 rad, is no motion a wheeled robot makes: a reset or a corrupt line. It is
+  // reported (file:line) and not applied: the chain goes on from the pose before it.
+  // Checked where the log has real timestamps; 0 = not checked.
+  double max_speed_mps = 5.0;
+  double max_turn_rate_radps = 10.0;
 };
 
 class LogReader {
@@ -130,6 +138,15 @@ class LogReader {
   // first repair on, every odometry pose the reader returns (ODOM, and the odometry and
   // laser poses of FLASER, RLASER and ROBOTLASER1) is placed on the repaired chain; the
   // poses of a log that never contradicts itself are returned exactly as written.
+  //
+  // Impossible input: scans whose timestamp is before the previous scan of the same laser
+  // are counted (scans_stamped_backwards()) and returned in file order, the order the
+  // sensors delivered them (the Intel log has single lines stamped up to 0.9 s ahead of
+  // their neighbours); an odometry increment
+  // beyond the plausible speed or turn rate (LogReaderOptions) is reported and not
+  // applied, so that a reset or a corrupt pose never teleports the robot: every later
+  // odometry pose is moved by the same rigid transform, and their increments stay as
+  // written.
   Next next();
 
   // The current record; valid until the next call to next().
@@ -144,6 +161,13 @@ class LogReader {
   // Odometry increments mirrored because they ran against the log's own measured
   // velocity (see LogReader::next()); 0 for a log whose odometry is self-consistent.
   std::size_t odometry_reversals_repaired() const;
+  // Odometry increments beyond LogReaderOptions' plausible speed or turn rate, not
+  // applied (each also in errors()).
+  std::size_t odometry_jumps_removed() const;
+  // Laser scans stamped before the previous scan of the same laser, and the line of the
+  // first: they are returned in file order, stamps as written.
+  std::size_t scans_stamped_backwards() const;
+  std::int64_t first_backwards_line() const;
   std::int64_t lines_read() const;
   // Bytes of the input file consumed so far (compressed bytes for .gz), for progress.
   std::uint64_t input_offset() const;

@@ -35,6 +35,9 @@ struct RunSummary {
   std::size_t log_error_count = 0U;
   std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
   std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
+  std::size_t odometry_jumps_removed = 0U;       // io::LogReader::odometry_jumps_removed()
+  std::size_t scans_stamped_backwards = 0U;      // io::LogReader::scans_stamped_backwards()
+  std::string first_backwards_at;                // "file:line" of the first of them
   double wall_time_s = 0.0;
 };
 

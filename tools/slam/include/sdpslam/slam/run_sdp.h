@@ -46,6 +46,9 @@ struct SdpRunSummary {
   std::size_t log_error_count = 0U;
   std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
   std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
+  std::size_t odometry_jumps_removed = 0U;       // io::LogReader::odometry_jumps_removed()
+  std::size_t scans_stamped_backwards = 0U;      // io::LogReader::scans_stamped_backwards()
+  std::string first_backwards_at;                // "file:line" of the first of them
   double wall_time_s = 0.0;
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
