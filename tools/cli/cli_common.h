@@ -20,6 +20,9 @@ enum ExitCode : int {
   kExitIo = 4,         // an output could not be written
 };
 
+// Size of a file in KiB (0 when it cannot be read), a progress total.
+std::uint64_t file_size_kib(const std::string& path);
+
 // Skipped log lines named on stderr, of each kind (malformed, skipped on purpose), before
 // the rest are only counted (io::write_log_errors).
 inline constexpr std::size_t kLogErrorsShown = 20U;
@@ -42,10 +45,14 @@ bool register_command(const CommandInfo& info);
   static const bool sdpslam_cli_registered_##ident =                        \
       ::sdpslam::cli::register_command(::sdpslam::cli::CommandInfo{name, description, order, setup_fn})
 
-// A one-line progress display on stderr ("scans 1200/13631  8.8%  412 scans/s  ETA 0:31"),
-// drawn only when stderr is a terminal and at most ~5 times a second. Silent otherwise.
+// The progress display of every long command, on stderr ("KiB 1200/13631  8.8%  412 KiB/s
+// ETA 0:31").
 class Progress {
  public:
+  // On a terminal: one line redrawn at most every 200 ms (done/total, percent, rate,
+  // ETA). Otherwise (a file, a pipe, a journal): the same figures as a plain line every
+  // kPlainInterval, so logs stay readable.
+  static constexpr std::chrono::seconds kPlainInterval{10};
   Progress(std::string what, std::uint64_t total);
   ~Progress();
   void update(std::uint64_t done);
@@ -54,7 +61,7 @@ class Progress {
  private:
   std::string what_;
   std::uint64_t total_;
-  bool enabled_;
+  bool terminal_;
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;

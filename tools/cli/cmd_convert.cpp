@@ -1,7 +1,6 @@
 // `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz)
 // to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
 // skipped and listed ("file:line: reason"), never fatal.
-#include <sys/stat.h>
 
 #include <cstdio>
 #include <memory>
@@ -44,9 +43,7 @@ int run_convert(const ConvertArgs& a) {
   }
   writer.comment("converted by sdpslam from " + a.in + " (" + io::to_string(reader.format()) + ")");
 
-  struct stat st {};
-  const std::uint64_t size_kib = ::stat(a.in.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) / 1024U : 0U;
-  Progress progress("KiB", size_kib);
+  Progress progress("KiB", file_size_kib(a.in));
   std::uint64_t lasers = 0;
   std::uint64_t odoms = 0;
   std::uint64_t params = 0;

@@ -85,9 +85,12 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
     return report("", kExitUsage, why);
   }
   ro.seed = a.seed;
-  ro.progress = true;
+  Progress progress("KiB", file_size_kib(a.log));
+  ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::SdpRunSummary s;
-  switch (slam::run_sdp_offline(a.log, ro, a.out, &s, &error)) {
+  const slam::SdpRunStatus status = slam::run_sdp_offline(a.log, ro, a.out, &s, &error);
+  progress.finish();
+  switch (status) {
     case slam::SdpRunStatus::kOk:
       io::write_log_errors(stderr, s.log_errors, s.log_error_count, kLogErrorsShown);
       std::fprintf(stderr,
@@ -112,10 +115,12 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
   ro.seed = a.seed;
-  ro.progress = true;
+  Progress progress("KiB", file_size_kib(a.log));
+  ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::RunSummary summary;
   std::string error;
   const slam::RunStatus st = slam::run_offline(a.log, ro, a.out, &summary, &error);
+  progress.finish();
   switch (st) {
     case slam::RunStatus::kOk:
       io::write_log_errors(stderr, summary.log_errors, summary.log_error_count, kLogErrorsShown);

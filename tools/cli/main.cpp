@@ -1,4 +1,5 @@
 // sdpslam: simulate, convert, evaluate and run SLAM on robot logs.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,32 +23,38 @@ bool register_command(const CommandInfo& info) {
   return true;
 }
 
+std::uint64_t file_size_kib(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) / 1024U : 0U;
+}
+
 Progress::Progress(std::string what, std::uint64_t total)
-    : what_(std::move(what)), total_(total), enabled_(::isatty(STDERR_FILENO) == 1),
+    : what_(std::move(what)), total_(total), terminal_(::isatty(STDERR_FILENO) == 1),
       start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
 
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::uint64_t done) {
-  if (!enabled_ || finished_) return;
+  if (finished_) return;
   const auto now = std::chrono::steady_clock::now();
-  if (done < total_ && now - last_draw_ < std::chrono::milliseconds(200)) return;
+  if (terminal_ && done < total_ && now - last_draw_ < std::chrono::milliseconds(200)) return;
+  if (!terminal_ && now - last_draw_ < kPlainInterval) return;
   last_draw_ = now;
   const double elapsed_s = std::chrono::duration<double>(now - start_).count();
   const double rate = elapsed_s > 0.0 ? static_cast<double>(done) / elapsed_s : 0.0;
   const double pct = total_ > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 0.0;
   const double eta_s = rate > 0.0 && total_ >= done ? static_cast<double>(total_ - done) / rate : 0.0;
   const int eta = static_cast<int>(eta_s + 0.5);
-  std::fprintf(stderr, "\r%s %llu/%llu %5.1f%%  %.0f %s/s  ETA %d:%02d   ", what_.c_str(),
+  std::fprintf(stderr, "%s%s %llu/%llu %5.1f%%  %.0f %s/s  ETA %d:%02d%s", terminal_ ? "\r" : "", what_.c_str(),
                static_cast<unsigned long long>(done), static_cast<unsigned long long>(total_), pct, rate,
-               what_.c_str(), eta / 60, eta % 60);
+               what_.c_str(), eta / 60, eta % 60, terminal_ ? "   " : "\n");
   std::fflush(stderr);
 }
 
 void Progress::finish() {
-  if (!enabled_ || finished_) return;
+  if (finished_) return;
   finished_ = true;
-  std::fprintf(stderr, "\n");
+  if (terminal_) std::fprintf(stderr, "\n");
 }
 
 }  // namespace sdpslam::cli

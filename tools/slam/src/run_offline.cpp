@@ -73,12 +73,8 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     scan_ms.push_back(ms);
     if (processed) processed_ms.push_back(ms);
     scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, processed});
-    if (options.progress && scans.size() % 200U == 0U) {
-      std::fprintf(stderr, "\rscans %zu processed %llu", scans.size(),
-                   static_cast<unsigned long long>(filter->stats().processed));
-    }
+    if (options.progress) options.progress(reader.input_offset());
   }
-  if (options.progress) std::fprintf(stderr, "\n");
   if (scans.empty()) {
     *error = log_path + ": no laser scan with odometry in the log";
     return RunStatus::kBadInput;

@@ -318,13 +318,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     if (cpu > 100.0) ++scans_cpu_over_100ms;
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
     scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
-    if (options.progress && scans.size() % 200U == 0U) {
-      std::fprintf(stderr, "\rscans %zu processed %llu segments %llu", scans.size(),
-                   static_cast<unsigned long long>(slam->bottom().stats().processed),
-                   static_cast<unsigned long long>(slam->stats().segments));
-    }
+    if (options.progress) options.progress(reader.input_offset());
   }
-  if (options.progress) std::fprintf(stderr, "\n");
   if (scans.empty()) {
     *error = log_path + ": no laser scan with odometry in the log";
     return SdpRunStatus::kBadInput;

@@ -13,6 +13,7 @@
 // Same log, options and seed -> bit-identical trajectory.txt and map files.
 // All files are written atomically.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,9 @@ struct RunOptions {
   RunMode mode = RunMode::kDpSlam;
   SlamConfig config;
   std::uint64_t seed = 1U;
-  bool progress = false;  // one-line progress on stderr (when it is a terminal)
+  // Called after every scan with the bytes of the log read so far (compressed bytes for
+  // .gz; io::LogReader::input_offset()), for a progress display; may be empty.
+  std::function<void(std::uint64_t input_bytes)> progress;
 };
 
 struct RunSummary {

@@ -20,6 +20,7 @@
 //                     non-deterministic fields (wall time, per-scan times, RSS).
 // Same log, options and seed -> bit-identical trajectory.txt, map and icp_error.csv.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,9 @@ struct SdpRunOptions {
   // only; the caller applies it before the file's keys.
   SdpProfile profile = kDefaultSdpProfile;
   std::uint64_t seed = 1U;
-  bool progress = false;
+  // Called after every scan with the bytes of the log read so far (compressed bytes for
+  // .gz; io::LogReader::input_offset()), for a progress display; may be empty.
+  std::function<void(std::uint64_t input_bytes)> progress;
 };
 
 struct SdpRunSummary {
