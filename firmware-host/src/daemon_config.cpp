@@ -32,6 +32,7 @@ struct ParseState {
   std::string error;
   std::FILE* stream = nullptr;
   int line = 0;
+  slam::IniDuplicates duplicates;
 };
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
@@ -61,6 +62,10 @@ char* read_line(char* str, int num, void* user) {
       while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
       if (!known_section(sec)) st->error = st->file + ":" + std::to_string(st->line) + ": unknown section [" + sec + "]";
     }
+  }
+  std::string why;
+  if (!st->duplicates.line(r, &why) && st->error.empty()) {
+    st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
   }
   return r;
 }
@@ -366,7 +371,7 @@ int handler(void* user, const char* section, const char* name, const char* value
   if (name == nullptr) {
     if (known_section(sec)) return 1;
     why = "unknown section [" + sec + "]";
-  } else {
+  } else if (st->duplicates.key(section, name, &why)) {
     const R r = handle_key(*st->config, sec, name, value, &why);
     if (r == R::kOk) return 1;
     if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
@@ -399,7 +404,7 @@ bool load_daemon_config(const std::string& path, DaemonConfig* config, std::stri
   (void)ini_parse_file(f, profile_handler, config);
   if (config->mode == SlamMode::kSdp) apply_profile(config->profile, &config->slam.filter, &config->sdp);
   std::rewind(f);
-  ParseState st{config, path, {}, f, 0};
+  ParseState st{config, path, {}, f, 0, {}};
   const int rc = ini_parse_stream(read_line, &st, handler, &st);
   std::fclose(f);
   if (!st.error.empty()) {

@@ -91,6 +91,24 @@ TEST(SlamConfig, unknown_key_is_rejected_with_file_and_line) {
   STRCMP_CONTAINS("alpha_typo", error.c_str());
 }
 
+// Either would make the file mean what its last occurrence says; [sdp] (read by
+// load_sdp_ini) is checked here too.
+TEST(SlamConfig, a_section_or_a_key_given_twice_is_rejected_with_file_and_line) {
+  const char* const cases[][2] = {
+      {"[filter]\nparticles = 10\n[motion]\nalpha_rot_from_rot = 0.1\n[filter]\n", ":5: section [filter] given twice"},
+      {"[motion]\nalpha_rot_from_rot = 0.1\nalpha_rot_from_rot = 0.2\n",
+       ":3: key 'alpha_rot_from_rot' given twice in section [motion]"},
+      {"[sdp]\ntop_particles = 30\ntop_particles = 40\n", ":3: key 'top_particles' given twice in section [sdp]"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = write_temp(c[0]);
+    slam::SlamConfig config;
+    std::string error;
+    CHECK_FALSE(slam::load_config_ini(path, &config, &error));
+    STRCMP_CONTAINS((path + c[1]).c_str(), error.c_str());
+  }
+}
+
 TEST(SlamConfig, out_of_range_value_is_rejected_naming_field_and_range) {
   const std::string path = write_temp("[filter]\nparticles = 100000\n");
   slam::SlamConfig c;

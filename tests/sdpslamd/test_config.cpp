@@ -120,6 +120,16 @@ TEST(SdpslamdConfig, unknown_section_is_rejected_at_its_line_even_when_empty) {
   expect_rejected("[can]\ninterface = can1\n\n[lidar]\n", 4, "unknown section [lidar]");
 }
 
+// Either would make the file mean what its last occurrence says.
+TEST(SdpslamdConfig, a_section_or_a_key_given_twice_is_rejected_at_its_line) {
+  expect_rejected("[can]\ninterface = can1\n[laser]\ndevice = /dev/ttyACM0\n[can]\n", 5,
+                  "section [can] given twice");
+  expect_rejected("[laser]\ndevice = /dev/ttyACM0\ndevice = /dev/ttyUSB0\n", 3,
+                  "key 'device' given twice in section [laser]");
+  expect_rejected("[sdp]\ntop_particles = 30\n[filter]\nparticles = 10\n[sdp]\nloop_closure = true\n", 5,
+                  "section [sdp] given twice");
+}
+
 TEST(SdpslamdConfig, unknown_key_is_rejected_with_its_line) {
   expect_rejected("[laser]\ndevice = /dev/ttyACM0\nspeed = 3\n", 3, "unknown key 'speed' in section [laser]");
 }

@@ -20,13 +20,19 @@ struct ParseState {
   std::string error;
   std::FILE* stream = nullptr;
   int line = 0;  // lines handed to inih so far = the line being handled
+  IniDuplicates duplicates;
 };
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
 char* read_line(char* str, int num, void* user) {
   auto* st = static_cast<ParseState*>(user);
   char* r = std::fgets(str, num, st->stream);
-  if (r != nullptr) ++st->line;
+  if (r == nullptr) return r;
+  ++st->line;
+  std::string why;
+  if (!st->duplicates.line(r, &why) && st->error.empty()) {
+    st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
+  }
   return r;
 }
 
@@ -146,6 +152,12 @@ int handler(void* user, const char* section, const char* name, const char* value
   auto* st = static_cast<ParseState*>(user);
   const int lineno = st->line;
   if (name == nullptr) return 1;  // section header alone
+  if (!st->error.empty()) return 0;
+  std::string dup;
+  if (!st->duplicates.key(section, name, &dup)) {
+    st->error = st->file + ":" + std::to_string(lineno) + ": " + dup;
+    return 0;
+  }
   // [sdp] belongs to the SDP-SLAM top level; its keys are read by load_sdp_ini (run_sdp.h).
   if (std::strcmp(section, "sdp") == 0) return 1;
   std::string why;
@@ -157,6 +169,26 @@ int handler(void* user, const char* section, const char* name, const char* value
 }
 
 }  // namespace
+
+bool IniDuplicates::line(const char* line, std::string* why) {
+  const char* p = line;
+  while (*p == ' ' || *p == '\t') ++p;
+  if (*p != '[') return true;
+  const char* end = std::strchr(p, ']');
+  if (end == nullptr) return true;  // malformed: inih reports it
+  std::string sec(p + 1, end);
+  while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
+  while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
+  if (sections_.insert(sec).second) return true;
+  *why = "section [" + sec + "] given twice (merge its keys into the first)";
+  return false;
+}
+
+bool IniDuplicates::key(const char* section, const char* name, std::string* why) {
+  if (keys_.insert({section, name}).second) return true;
+  *why = "key '" + std::string(name) + "' given twice in section [" + section + "]";
+  return false;
+}
 
 bool is_slam_config_section(const std::string& section) {
   return section == "filter" || section == "motion" || section == "observation" || section == "proposal" ||
@@ -228,7 +260,7 @@ bool load_config_ini(const std::string& path, SlamConfig* config, std::string* e
     if (error != nullptr) *error = why;
     return false;
   }
-  ParseState st{config, path, {}, f, 0};
+  ParseState st{config, path, {}, f, 0, {}};
   const int rc = ini_parse_stream(read_line, &st, handler, &st);
   std::fclose(f);
   if (!st.error.empty()) {

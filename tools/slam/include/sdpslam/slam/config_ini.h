@@ -3,7 +3,9 @@
 // key). Sections and keys mirror DpSlamOptions; `[log] default_range_max_m` sets the
 // log reader's no-return threshold for formats that do not carry one.
 #include <cstdio>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "sdpslam/core/dpslam_options.h"
 #include "sdpslam/io/log_reader.h"
@@ -18,7 +20,8 @@ struct SlamConfig {
 // Applies the keys of `path` on top of *config (keys not in the file keep their value).
 // False iff the file cannot be read, a line is malformed, a section/key is unknown, a
 // value is not a finite number of the right kind, or a value makes the options invalid;
-// `error` is then "file:line: reason". An [sdp] section (SDP-SLAM's top level, read by
+// `error` is then "file:line: reason"; also iff a section or a key is given twice
+// (IniDuplicates), [sdp] included. An [sdp] section (SDP-SLAM's top level, read by
 // load_sdp_ini in run_sdp.h) is skipped.
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
 
@@ -27,6 +30,22 @@ bool load_config_ini(const std::string& path, SlamConfig* config, std::string* e
 // directory (fopen accepts one on Linux, and reading it looks like an empty file: the
 // built-in defaults would run unannounced). Files, pipes and /dev/null are accepted.
 std::FILE* open_config_file(const std::string& path, std::string* error);
+
+// A section given twice, or a key given twice in one section, makes a file mean what its
+// last occurrence says, which nobody reading the first one expects: every INI reader
+// refuses both. Feed it each line as read (for section headers, which the packaged inih
+// does not hand to handlers) and each key as handled.
+class IniDuplicates {
+ public:
+  // False, with `why`, when `line` is a header of a section already opened.
+  bool line(const char* line, std::string* why);
+  // False, with `why`, when `name` was already given in `section`.
+  bool key(const char* section, const char* name, std::string* why);
+
+ private:
+  std::set<std::string> sections_;
+  std::set<std::pair<std::string, std::string>> keys_;
+};
 
 // One `key = value` of the sections above ([filter] [motion] [observation] [map]
 // [capacity] [log]), for programs whose own INI files embed these sections (sdpslamd).
