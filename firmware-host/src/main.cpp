@@ -2,6 +2,7 @@
 //
 //   sdpslamd --config FILE [--out DIR] [--can-candump LOG [--can-candump-start-us T]
 //            [--can-candump-speed S]] [--check-config]
+//   sdpslamd --help | --version     (on stdout, exit 0)
 //
 // Exit codes (as the sdpslam command): 0 stopped by SIGINT/SIGTERM with final outputs
 // written, 1 internal failure, 2 bad command line, 3 bad configuration or input,
@@ -14,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "sdpslam/core/version.h"
 #include "sdpslam/daemon/candump_replay_bus.h"
 #include "sdpslam/daemon/daemon.h"
 #include "sdpslam/drivers/can_wheel_encoders.h"
@@ -30,9 +32,11 @@ void on_signal(int) { g_stop = 1; }
 
 enum ExitCode : int { kExitOk = 0, kExitInternal = 1, kExitUsage = 2, kExitBadInput = 3, kExitIo = 4 };
 
+// Help asked for goes to stdout (exit 0); after a usage error, to stderr (exit 2).
 int usage(const char* why) {
+  std::FILE* out = why != nullptr ? stderr : stdout;
   if (why != nullptr) std::fprintf(stderr, "sdpslamd: %s\n", why);
-  std::fprintf(stderr,
+  std::fprintf(out,
                "usage: sdpslamd --config FILE [--out DIR] [--check-config]\n"
                "                [--can-candump LOG [--can-candump-start-us T] [--can-candump-speed S]]\n"
                "  --config FILE           INI configuration (every key: sdpslamd.ini)\n"
@@ -40,8 +44,10 @@ int usage(const char* why) {
                "  --check-config          load and validate the configuration, then exit\n"
                "  --can-candump LOG       replay a candump -l log as the CAN bus instead of SocketCAN\n"
                "  --can-candump-start-us  CLOCK_MONOTONIC time (us) the log's first frame is due\n"
-               "  --can-candump-speed     replay speed factor (default 1)\n");
-  return kExitUsage;
+               "  --can-candump-speed     replay speed factor (default 1)\n"
+               "  --version               print the version and exit\n"
+               "  --help                  print this help and exit\n");
+  return why != nullptr ? kExitUsage : kExitOk;
 }
 
 int start_can_encoders(void* ctx) { return static_cast<sdpslam::drivers::CanWheelEncoders*>(ctx)->start(); }
@@ -85,7 +91,9 @@ int main(int argc, char** argv) {
     } else if (a == "--check-config") {
       check_only = true;
     } else if (a == "--help" || a == "-h") {
-      usage(nullptr);
+      return usage(nullptr);
+    } else if (a == "--version") {
+      std::printf("sdpslamd %s\n", version_string());
       return kExitOk;
     } else {
       return usage(("unknown argument " + a).c_str());
