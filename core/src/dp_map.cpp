@@ -30,7 +30,7 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   if (!std::isfinite(o.origin_x_m) || !std::isfinite(o.origin_y_m)) return false;
   if (!(o.resolution_m > 0.0) || !(o.width_m > 0.0) || !(o.height_m > 0.0)) return false;
   if (o.tile_capacity == 0U || o.tile_capacity > capacity::kDpMaxTiles || o.observation_capacity == 0U) return false;
-  if (o.observation_capacity > (1U << 30U)) return false;  // index_slots_for() < 2^31
+  if (o.observation_capacity > capacity::kDpMaxObservations) return false;  // index_slots_for() < 2^31
   d->width_cells = cells_for(o.width_m, o.resolution_m);
   d->height_cells = cells_for(o.height_m, o.resolution_m);
   if (d->width_cells <= 0 || d->height_cells <= 0) return false;

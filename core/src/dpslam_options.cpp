@@ -91,14 +91,14 @@ bool DpSlamOptions::validate(char* why, std::size_t n) const {
     c.real("map.width_m*height_m/resolution_m^2 (cells)", cells, 1.0, 4.0e9);
   }
   c.integer("map.tile_capacity", map_tile_capacity, 0U, capacity::kDpMaxTiles);
-  c.integer("map.observations_base", map_observations_base, 0U, 0xF0000000U);
+  c.integer("map.observations_base", map_observations_base, 0U, capacity::kDpMaxObservations);
   c.integer("map.observations_per_particle", map_observations_per_particle, 1U, 100000000U);
   c.integer("capacity.ancestry_nodes_per_particle", ancestry_nodes_per_particle, 1U, capacity::kDpSlamMaxNodesPerParticle);
   c.integer("capacity.path_entries_per_particle", path_entries_per_particle, 1U, capacity::kDpSlamMaxPathEntriesPerParticle);
   if (c.ok) {
     const std::uint64_t obs = static_cast<std::uint64_t>(map_observations_base) +
                               static_cast<std::uint64_t>(particle_count) * map_observations_per_particle;
-    c.integer("map.observations_base + particles*observations_per_particle", obs, 1U, 0xF0000000U);
+    c.integer("map.observations_base + particles*observations_per_particle", obs, 1U, capacity::kDpMaxObservations);
     c.integer("particles*capacity.path_entries_per_particle + extra_path_entries",
               static_cast<std::uint64_t>(particle_count) * path_entries_per_particle + extra_path_entries, 1U,
               0xF0000000U);

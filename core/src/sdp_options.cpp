@@ -70,7 +70,7 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.real("free_threshold", free_threshold, 0.0, occupied_threshold);
   c.integer("work_cells_per_scan", work_cells_per_scan, 1024U, 1U << 28U);
   c.integer("map_tile_capacity", map_tile_capacity, 0U, capacity::kDpMaxTiles);
-  c.integer("map_observation_capacity", map_observation_capacity, 0U, 0xE0000000U);
+  c.integer("map_observation_capacity", map_observation_capacity, 0U, capacity::kDpMaxObservations);
   c.integer("permanent_map_tiles", permanent_map_tiles, 1U, capacity::kDpMaxTiles);
   c.real("icp_correction_weight", icp_correction_weight, 0.0, 100.0);
   c.real("icp_correction_lever_m", icp_correction_lever_m, 0.0, 100.0);

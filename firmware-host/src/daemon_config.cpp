@@ -1,6 +1,7 @@
 #include "sdpslam/daemon/daemon_config.h"
 
 #include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/serial_port.h"
 #include "sdpslam/slam/run_sdp.h"
 
@@ -347,6 +348,15 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       return R::kOk;
     }
     if (key == "loop_slice_ms") return ms(c.loop_slice_us, 0.1, 100.0, false);
+    if (key == "memory_budget_mib") {
+      if (!real_in(v, 8.0, 65536.0, false, &d, why)) return R::kBad;
+      if (d != std::floor(d)) {
+        *why = std::string("'") + v + "' is not a whole number of MiB";
+        return R::kBad;
+      }
+      c.memory_budget_mib = static_cast<std::uint32_t>(d);
+      return R::kOk;
+    }
   } else {
     std::string slam_why;
     switch (slam::apply_config_key(&c.slam, sec, key, v, &slam_why)) {
@@ -441,6 +451,22 @@ bool load_daemon_config(const std::string& path, DaemonConfig* config, std::stri
       *error = at + "sdp: bottom level with the room for " + std::to_string(config->sdp.max_levels) + " levels: " + why;
       return false;
     }
+  }
+  // The whole state is sized here, before any work: what is approved here can start.
+  const std::size_t arena_bytes = engine_arena_bytes(*config);
+  if (arena_bytes == 0U) {
+    *error = at + "the SLAM options size no valid state (a map or pool capacity beyond what the core can address)";
+    return false;
+  }
+  const double arena_mb = static_cast<double>(arena_bytes) / (1024.0 * 1024.0);
+  if (arena_mb > static_cast<double>(config->memory_budget_mib)) {
+    char b[300];
+    std::snprintf(b, sizeof b,
+                  "the SLAM state needs %.1f MiB, above [daemon] memory_budget_mib = %u (lower the [map]/[sdp] capacities "
+                  "or raise the budget, and the unit's MemoryMax= with it)",
+                  arena_mb, config->memory_budget_mib);
+    *error = at + b;
+    return false;
   }
   return true;
 }

@@ -12,7 +12,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <memory>
+#include <new>
 #include <string>
 
 #include "sdpslam/core/version.h"
@@ -52,9 +54,27 @@ int usage(const char* why) {
 
 int start_can_encoders(void* ctx) { return static_cast<sdpslam::drivers::CanWheelEncoders*>(ctx)->start(); }
 
+int run_daemon(int argc, char** argv);
+
 }  // namespace
 
+// No exception leaves main: out of memory (the state is sized and checked against
+// [daemon] memory_budget_mib before any work, so this is the rest of the process) and any
+// other failure become a message and exit 1, which systemd's Restart=on-failure retries.
 int main(int argc, char** argv) {
+  try {
+    return run_daemon(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "sdpslamd: out of memory\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sdpslamd: internal error: %s\n", e.what());
+  }
+  return kExitInternal;
+}
+
+namespace {
+
+int run_daemon(int argc, char** argv) {
   using namespace sdpslam;
   std::string config_path;
   std::string out_dir;
@@ -109,9 +129,16 @@ int main(int argc, char** argv) {
   }
   if (!out_dir.empty()) config.output_directory = out_dir;
   if (check_only) {
-    std::printf("%s: ok (mode %s, %u particles, %.1f MB SLAM arena, laser %s on %s, encoders %s on %s, outputs in %s)\n",
+    // The same initialisation as a start (the state allocated and every part set up), so
+    // that what is approved here starts.
+    if (!daemon::make_engine(config, &error)) {
+      std::fprintf(stderr, "sdpslamd: %s: %s\n", config_path.c_str(), error.c_str());
+      return kExitBadInput;
+    }
+    std::printf("%s: ok (mode %s, %u particles, %.1f MiB SLAM state of %u MiB allowed, laser %s on %s, encoders %s on "
+                "%s, outputs in %s)\n",
                 config_path.c_str(), daemon::to_string(config.mode), config.slam.filter.particle_count,
-                static_cast<double>(daemon::engine_arena_bytes(config)) * 1e-6,
+                static_cast<double>(daemon::engine_arena_bytes(config)) / (1024.0 * 1024.0), config.memory_budget_mib,
                 daemon::to_string(config.laser_protocol), config.laser_device.c_str(),
                 drivers::to_string(config.encoders.protocol), config.can_interface.c_str(),
                 config.output_directory.c_str());
@@ -214,3 +241,5 @@ int main(int argc, char** argv) {
                lf.p50_ms, lf.p99_ms, lf.max_ms, ok ? "written" : "NOT written", config.output_directory.c_str());
   return ok ? kExitOk : kExitIo;
 }
+
+}  // namespace

@@ -120,6 +120,44 @@ TEST(SdpslamdConfig, unknown_section_is_rejected_at_its_line_even_when_empty) {
   expect_rejected("[can]\ninterface = can1\n\n[lidar]\n", 4, "unknown section [lidar]");
 }
 
+// The state is sized when the file is read: a capacity beyond what the core addresses, or
+// a state above the declared budget, is refused before any work (not at start, not by an
+// out-of-memory abort that systemd would restart in a loop).
+TEST(SdpslamdConfig, a_state_the_core_cannot_address_or_above_the_budget_is_refused) {
+  expect_rejected("[sdp]\nmap_observation_capacity = 3758096384\n", 2, "out of range [0, 1073741824]");
+  DaemonConfig c;
+  std::string error;
+  const std::string big = write_ini("[sdp]\nmap_observation_capacity = 1000000000\n");
+  CHECK_FALSE(load_daemon_config(big, &c, &error));
+  STRCMP_CONTAINS("above [daemon] memory_budget_mib = 128", error.c_str());
+  DaemonConfig d;
+  const std::string small = write_ini("[daemon]\nmemory_budget_mib = 32\n");
+  CHECK_FALSE(load_daemon_config(small, &d, &error));
+  STRCMP_CONTAINS("memory_budget_mib = 32", error.c_str());
+  DaemonConfig e;
+  CHECK_TEXT(load_daemon_config(write_ini("[daemon]\nmemory_budget_mib = 4096\n[sdp]\nmap_observation_capacity = 20000000\n"),
+                                &e, &error),
+             error.c_str());
+  expect_rejected("[daemon]\nmemory_budget_mib = 12.5\n", 2, "not a whole number");
+}
+
+// The unit's MemoryMax= sits above the default budget of the state, with room for the
+// rest of the process.
+TEST(SdpslamdConfig, the_units_memory_ceiling_is_above_the_default_state_budget) {
+  std::string unit = SDPSLAMD_EXAMPLE_INI;
+  unit = unit.substr(0, unit.rfind('/')) + "/systemd/sdpslamd.service";
+  std::FILE* f = std::fopen(unit.c_str(), "r");
+  CHECK_TEXT(f != nullptr, unit.c_str());
+  char line[256];
+  long max_mib = 0;
+  while (std::fgets(line, sizeof line, f) != nullptr) {
+    if (std::sscanf(line, "MemoryMax=%ldM", &max_mib) == 1) break;
+  }
+  std::fclose(f);
+  const DaemonConfig defaults;
+  CHECK_TEXT(max_mib >= 2L * defaults.memory_budget_mib, "MemoryMax= missing or below twice the state budget");
+}
+
 // Either would make the file mean what its last occurrence says.
 TEST(SdpslamdConfig, a_section_or_a_key_given_twice_is_rejected_at_its_line) {
   expect_rejected("[can]\ninterface = can1\n[laser]\ndevice = /dev/ttyACM0\n[can]\n", 5,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <vector>
 
 #include "cli_common.h"
@@ -84,6 +85,10 @@ int main(int argc, char** argv) {
     for (auto& [sub, run] : runners) {
       if (sub->parsed()) return run();
     }
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "sdpslam: out of memory: the options ask for more memory than this machine gives (lower the "
+                         "[map]/[sdp] capacities)\n");
+    return kExitBadInput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sdpslam: internal error: %s\n", e.what());
     return kExitInternal;

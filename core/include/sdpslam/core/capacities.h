@@ -48,6 +48,9 @@ inline constexpr std::uint32_t kDpTileSideCells = 1U << kDpTileSideLog2;
 inline constexpr std::uint32_t kDpTileCells = kDpTileSideCells * kDpTileSideCells;
 // A DpMap observation addresses its cell as (tile slot << 2k) | cell-in-tile in 32 bits.
 inline constexpr std::uint32_t kDpMaxTiles = 0xFFFFFFFFU >> (2U * kDpTileSideLog2);
+// Observations of one DpMap: its (owner, cell) index has 1.5 slots per observation, and
+// slot numbers stay below 2^31. The options' validators refuse more.
+inline constexpr std::uint32_t kDpMaxObservations = 1U << 30U;
 
 #ifndef SDPSLAM_VIEW_CACHE_SLOTS_LOG2
 #define SDPSLAM_VIEW_CACHE_SLOTS_LOG2 14

@@ -77,6 +77,10 @@ struct DaemonConfig {
   // [daemon]
   std::int64_t log_interval_us = 1000000;    // one line per event kind at most this often
   std::int64_t loop_slice_us = 5000;         // longest wait on the laser before CAN is read
+  // The SLAM arena (the whole SLAM state, sized once at start) may not exceed this; the
+  // unit's MemoryMax= (sdpslamd.service) leaves room above it for the rest of the
+  // process (drivers, queues, the map rendered for output).
+  std::uint32_t memory_budget_mib = 128U;
 
   static constexpr std::uint32_t kMaxScanQueue = 16U;
 };
