@@ -2,36 +2,22 @@
 // with file:line and its reason (the first kLogErrorsShown of each kind), the rest are
 // counted, and the good scans still make a trajectory.
 #include <CppUTest/TestHarness.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "sdpslam/io/atomic_file.h"
+#include "run_program.h"
 #include "shared_data.h"
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using Run = sdpslam::test::ProgramRun;
 
-Run run_cli(const std::string& args) {
-  Run r;
-  const std::string cmd = std::string(SDPSLAM_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+Run run_cli(const std::string& args) { return sdpslam::test::run_program(std::string(SDPSLAM_CLI_PATH) + " " + args); }
 
 std::size_t lines_in(const std::string& path) {
   std::ifstream in(path);

@@ -1,7 +1,6 @@
 // `sdpslam evaluate` end to end: figures on a tiny synthetic log, JSON output, and exit
 // codes with file:line for bad input.
 #include <CppUTest/TestHarness.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -11,26 +10,15 @@
 
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
+#include "run_program.h"
 #include "shared_data.h"
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out;  // stdout and stderr together
-};
+using Run = sdpslam::test::ProgramRun;
 
 Run run_evaluate(const std::string& args) {
-  Run r;
-  const std::string cmd = std::string(SDPSLAM_CLI_PATH) + " evaluate " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
+  return sdpslam::test::run_program(std::string(SDPSLAM_CLI_PATH) + " evaluate " + args);
 }
 
 std::string slurp(const std::string& path) {
