@@ -349,12 +349,8 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
     }
     if (key == "loop_slice_ms") return ms(c.loop_slice_us, 0.1, 100.0, false);
     if (key == "memory_budget_mib") {
-      if (!real_in(v, 8.0, 65536.0, false, &d, why)) return R::kBad;
-      if (d != std::floor(d)) {
-        *why = std::string("'") + v + "' is not a whole number of MiB";
-        return R::kBad;
-      }
-      c.memory_budget_mib = static_cast<std::uint32_t>(d);
+      if (!int_in(v, 8, 65536, &i, why)) return R::kBad;
+      c.memory_budget_mib = static_cast<std::uint32_t>(i);
       return R::kOk;
     }
   } else {

@@ -138,7 +138,7 @@ TEST(SdpslamdConfig, a_state_the_core_cannot_address_or_above_the_budget_is_refu
   CHECK_TEXT(load_daemon_config(write_ini("[daemon]\nmemory_budget_mib = 4096\n[sdp]\nmap_observation_capacity = 20000000\n"),
                                 &e, &error),
              error.c_str());
-  expect_rejected("[daemon]\nmemory_budget_mib = 12.5\n", 2, "not a whole number");
+  expect_rejected("[daemon]\nmemory_budget_mib = 12.5\n", 2, "not an integer");
 }
 
 // The unit's MemoryMax= sits above the default budget of the state, with room for the

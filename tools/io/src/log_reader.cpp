@@ -212,18 +212,6 @@ struct LogReader::Impl {
     return types[1];
   }
 
-  // Counts a laser whose stamp is before the previous one of its type (the log is
-  // processed in file order, the order its sensors delivered; trajectories keep the
-  // stamps as written).
-  void check_stamp_order(Next got) {
-    if (got != Next::kLaser || !laser.has_stamp) return;
-    const TypeState& t = type_of(got);
-    if (t.latched_stamp && laser.stamp_us < t.last_stamp_us) {
-      if (stamps_backwards == 0U) first_backwards_line = line_no;
-      ++stamps_backwards;
-    }
-  }
-
   // The odometry pose of a record on the chain without impossible jumps; reports one.
   Pose2 plausible(TypeState& t, const Pose2& written, std::int64_t stamp_us, bool has_stamp) {
     Pose2 out = jump_offset.compose(written);
@@ -253,21 +241,32 @@ struct LogReader::Impl {
     t.last_pose = out;
     return out;
   }
-  void stamped(TypeState& t, std::int64_t stamp_us, bool has_stamp) {
-    if (!has_stamp) return;
-    t.last_stamp_us = stamp_us;
-    t.latched_stamp = true;
-  }
-  void plausible_record(Next got) {
+  // One record's place in its type's sequence: a laser stamped before the previous one
+  // of its type is counted (the log is processed in file order, the order its sensors
+  // delivered; trajectories keep the stamps as written), an impossible odometry jump is
+  // removed, and the record's stamp becomes the type's latest.
+  void sequence_record(Next got) {
     if (got == Next::kOdom) {
       odom.pose = plausible(types[0], odom.pose, odom.stamp_us, true);
-      stamped(types[0], odom.stamp_us, true);
+      types[0].last_stamp_us = odom.stamp_us;
+      types[0].latched_stamp = true;
       return;
     }
-    if (got != Next::kLaser || !laser.has_odom_pose) return;
-    const Pose2 written = laser.odom_pose;
-    laser.odom_pose = plausible(type_of(got), written, laser.stamp_us, laser.has_stamp);
-    if (laser.has_laser_pose) laser.laser_pose = laser.odom_pose.compose(between(written, laser.laser_pose));
+    if (got != Next::kLaser) return;
+    TypeState& t = type_of(got);
+    if (laser.has_stamp && t.latched_stamp && laser.stamp_us < t.last_stamp_us) {
+      if (stamps_backwards == 0U) first_backwards_line = line_no;
+      ++stamps_backwards;
+    }
+    if (laser.has_odom_pose) {
+      const Pose2 written = laser.odom_pose;
+      laser.odom_pose = plausible(t, written, laser.stamp_us, laser.has_stamp);
+      if (laser.has_laser_pose) laser.laser_pose = laser.odom_pose.compose(between(written, laser.laser_pose));
+    }
+    if (laser.has_stamp) {
+      t.last_stamp_us = laser.stamp_us;
+      t.latched_stamp = true;
+    }
   }
 
   // The increment's forward component, from the raw coordinate differences: exactly 0
@@ -551,10 +550,8 @@ LogReader::Next LogReader::next() {
       continue;
     }
     if (got == Next::kEnd) continue;  // an ignored message type
-    s.check_stamp_order(got);
     if (s.format == LogFormat::kCarmen) s.repair_record(got);
-    s.plausible_record(got);
-    if (got == Next::kLaser) s.stamped(s.type_of(got), s.laser.stamp_us, s.laser.has_stamp);
+    s.sequence_record(got);
     switch (got) {
       case Next::kLaser: s.laser.line = s.line_no; break;
       case Next::kOdom: s.odom.line = s.line_no; break;
