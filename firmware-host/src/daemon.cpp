@@ -44,7 +44,9 @@ Daemon::Daemon(const DaemonConfig& config, const DaemonIo& io, EventLog& log)
       odom_(paired_, config.drive) {}
 
 bool Daemon::start(std::string* error) {
-  if (!io::make_directories(config_.output_directory, error)) return false;
+  // Made, cleaned of an interrupted run's leftovers and proven writable before any
+  // device is opened.
+  if (!outputs_.begin(config_.output_directory, error)) return false;
   if (config_.input_log && !recorder_.open(config_.output_directory + "/input.clf", error)) return false;
   start_us_ = io_.clock->now_us();
   next_output_us_ = start_us_ + config_.output_period_us;
@@ -233,6 +235,7 @@ bool Daemon::finish() {
   update_odometry();
   place_scans(io_.clock->now_us(), true);
   io_.engine->finish();
+  written_at_scans_ = ~std::uint64_t{0};  // finishing may move the path: always delivered
   return write_outputs();
 }
 
@@ -240,19 +243,28 @@ bool Daemon::write_outputs() {
   const std::int64_t t0 = io_.clock->now_us();
   std::string error;
   bool ok = true;
-  const std::vector<io::StampedPose> trajectory = io_.engine->trajectory();
-  if (config_.write_map) {
-    io::OccupancyImage image;
-    io_.engine->map_image(&image);
-    ok = slam::write_trajectory_and_map(config_.output_directory, trajectory, image, &error);
+  // The set is rendered and written only when a scan was placed since the last one
+  // delivered: an idle robot does not rewrite (and fsync) the same files every period.
+  const bool changed = counters_.scans_placed != written_at_scans_;
+  if (changed) {
+    const std::vector<io::StampedPose> trajectory = io_.engine->trajectory();
+    if (config_.write_map) {
+      io::OccupancyImage image;
+      io_.engine->map_image(&image);
+      ok = slam::write_trajectory_and_map(outputs_.staging_dir(), trajectory, image, &error);
+    } else {
+      ok = io::write_trajectory(outputs_.path("trajectory.txt"), trajectory, &error);
+    }
+    ok = ok && outputs_.commit(&error);
   } else {
-    ok = io::write_trajectory(config_.output_directory + "/trajectory.txt", trajectory, &error);
+    ++counters_.output_writes_unchanged;
   }
   const std::int64_t dt = io_.clock->now_us() - t0;
   if (dt > counters_.max_output_write_us) counters_.max_output_write_us = dt;
-  if (ok) {
+  if (changed && ok) {
     ++counters_.output_writes;
-  } else {
+    written_at_scans_ = counters_.scans_placed;
+  } else if (changed) {
     ++counters_.output_failures;
     last_output_error_ = error;
     log_.log(Event::kOutput, "write failed, previous files kept: %s", error.c_str());
@@ -342,6 +354,7 @@ std::string Daemon::status_json() const {
         u(rs.roundtrip_failures) + "},\n";
   js += "  \"engine\": {" + io_.engine->status_json() + "},\n";
   js += "  \"outputs\": {\"writes\": " + u(c.output_writes) + ", \"failures\": " + u(c.output_failures) +
+        ", \"unchanged\": " + u(c.output_writes_unchanged) +
         ", \"max_write_ms\": " + fmt_ms(static_cast<double>(c.max_output_write_us) / 1000.0) + "},\n";
   js += "  \"events\": {\"logged\": " + u(log_.printed()) + ", \"suppressed\": " + u(log_.suppressed()) + "},\n";
   js += "  \"cpu\": {\"user_s\": " + fmt_ms(user_s) + ", \"system_s\": " + fmt_ms(sys_s) + ", \"percent\": " +

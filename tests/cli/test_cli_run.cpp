@@ -2,6 +2,8 @@
 // with file:line and its reason (the first kLogErrorsShown of each kind), the rest are
 // counted, and the good scans still make a trajectory.
 #include <CppUTest/TestHarness.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -122,4 +124,53 @@ TEST(CliRun, an_odometry_jump_and_time_going_backwards_are_reported_and_handled)
     STRCMP_CONTAINS("\"odometry_jumps_removed\": 1", ss.str().c_str());
     STRCMP_CONTAINS("\"scans_stamped_backwards\": 1", ss.str().c_str());
   }
+}
+
+// An output folder that cannot be written fails at once, naming it, with the I/O exit
+// status - not after the whole log has been processed.
+TEST(CliRun, an_unwritable_output_folder_fails_before_any_work) {
+  const std::string log = log_with_bad_lines(0);
+  std::string out = dir + "/locked";
+  if (::geteuid() == 0) {
+    out = "/proc";  // root writes wherever a mode allows; /proc takes no new entries
+  } else {
+    CHECK_EQUAL(0, ::mkdir(out.c_str(), 0555));
+  }
+  for (const char* mode : {"sdp", "dpslam"}) {
+    const Run r = run_cli("run " + log + " --mode " + mode + " --out " + out);
+    LONGS_EQUAL_TEXT(4, r.status, r.out.c_str());
+    STRCMP_CONTAINS(("cannot write in output directory '" + out + "'").c_str(), r.out.c_str());
+    CHECK_TEXT(r.out.find("scans (") == std::string::npos, r.out.c_str());
+  }
+}
+
+// The outputs arrive as one set listed in manifest.txt; a dpslam run after an sdp run
+// removes the sdp run's ICP files, and a killed run's temporaries are cleaned up.
+TEST(CliRun, outputs_are_one_run_s_set) {
+  const std::string log = log_with_bad_lines(0);
+  const std::string out = dir + "/out";
+  Run r = run_cli("run " + log + " --mode sdp --out " + out);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  std::ifstream sdp_manifest(out + "/manifest.txt");
+  std::stringstream m1;
+  m1 << sdp_manifest.rdbuf();
+  STRCMP_CONTAINS(" icp_error.csv\n", m1.str().c_str());
+  STRCMP_CONTAINS(" trajectory.txt\n", m1.str().c_str());
+  // What a run killed between write and rename leaves (pid 2^22 + 1 is above Linux's
+  // largest pid, so no process owns it).
+  {
+    std::ofstream torn(out + "/.map.pgm.tmp.4194305.0");
+    torn << "torn";
+  }
+  r = run_cli("run " + log + " --mode dpslam --out " + out);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  std::ifstream probe(out + "/icp_error.csv");
+  CHECK_FALSE(probe.good());
+  std::ifstream torn(out + "/.map.pgm.tmp.4194305.0");
+  CHECK_FALSE(torn.good());
+  std::ifstream dp_manifest(out + "/manifest.txt");
+  std::stringstream m2;
+  m2 << dp_manifest.rdbuf();
+  CHECK_TEXT(m2.str().find("icp_error") == std::string::npos, m2.str().c_str());
+  STRCMP_CONTAINS(" stats.json\n", m2.str().c_str());
 }

@@ -264,6 +264,9 @@ qemu)
       if [ "$base" = stats.json ]; then  # wall time and memory use are measurements
         grep -v '"timing"' "$f" >"$work/$name-amd64.stats" && a=$work/$name-amd64.stats
         grep -v '"timing"' "$b" >"$work/$name-$arch.stats" && b=$work/$name-$arch.stats
+      elif [ "$base" = manifest.txt ]; then  # lists stats.json's size and checksum
+        grep -v ' stats.json$' "$f" >"$work/$name-amd64.manifest" && a=$work/$name-amd64.manifest
+        grep -v ' stats.json$' "$b" >"$work/$name-$arch.manifest" && b=$work/$name-$arch.manifest
       fi
       if cmp -s "$a" "$b"; then
         say "  identical: $name/$base ($(stat -c %s "$f") bytes)"

@@ -326,3 +326,29 @@ TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {
   LONGS_EQUAL(2, t.size());
   ::rmdir(status.c_str());
 }
+
+// Trajectory and map are delivered as one set (manifest.txt) and only when a scan was
+// placed since the last delivery: an idle robot rewrites (and fsyncs) nothing but its
+// status.
+TEST(SdpslamdLoop, idle_periods_rewrite_nothing_and_the_set_has_a_manifest) {
+  Rig r;
+  r.make();
+  r.odom(0, 1000000);
+  r.laser.deliver(1050000);
+  r.odom(100, 1100000);
+  CHECK_TRUE(r.d->write_outputs());
+  LONGS_EQUAL(1, r.d->counters().output_writes);
+  CHECK_TRUE(file_exists(r.config.output_directory + "/manifest.txt"));
+  CHECK_TRUE(r.d->write_outputs());
+  CHECK_TRUE(r.d->write_outputs());
+  LONGS_EQUAL(1, r.d->counters().output_writes);
+  LONGS_EQUAL(2, r.d->counters().output_writes_unchanged);
+  r.laser.deliver(1150000);
+  r.odom(200, 1200000);
+  CHECK_TRUE(r.d->write_outputs());
+  LONGS_EQUAL(2, r.d->counters().output_writes);
+  std::vector<io::StampedPose> t;
+  std::string error;
+  CHECK_TRUE(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error));
+  LONGS_EQUAL(2, t.size());
+}

@@ -79,8 +79,16 @@ bool AtomicOutputFile::open(const std::string& path, std::string* error) {
     if (error != nullptr) *error += " (temporary '" + temp + "')";
     return false;
   }
-  std::FILE* f = ::fdopen(fd, "wb");
+  fd_ = fd;
+  write_errno_ = 0;
+  cookie_io_functions_t io{};
+  io.write = [](void* self, const char* data, std::size_t size) -> ssize_t {
+    return static_cast<ssize_t>(write_to_fd(self, data, size));
+  };
+  io.close = close_fd;
+  std::FILE* f = ::fopencookie(this, "wb", io);
   if (f == nullptr) {
+    fd_ = -1;
     const int err = errno;
     ::close(fd);
     ::unlink(temp.c_str());
@@ -101,13 +109,12 @@ bool AtomicOutputFile::commit(std::string* error) {
   int err = 0;
   std::string what;
   if (std::ferror(file_) != 0) {
-    // The stream does not keep errno; EIO is the honest generic cause.
-    err = EIO;
+    err = write_errno_ != 0 ? write_errno_ : EIO;
     what = "a write failed on";
   } else if (std::fflush(file_) != 0) {
-    err = errno;
-    what = "flush failed on";
-  } else if (::fsync(::fileno(file_)) != 0) {
+    err = write_errno_ != 0 ? write_errno_ : errno;
+    what = "a write failed on";
+  } else if (::fsync(fd_) != 0) {
     err = errno;
     what = "fsync failed on";
   }
@@ -132,6 +139,29 @@ bool AtomicOutputFile::commit(std::string* error) {
   std::string base;
   split_path(path_, &dir, &base);
   return fsync_directory(dir, error);
+}
+
+long AtomicOutputFile::write_to_fd(void* self, const char* data, std::size_t size) {
+  auto* out = static_cast<AtomicOutputFile*>(self);
+  std::size_t done = 0U;
+  while (done < size) {
+    const ssize_t n = ::write(out->fd_, data + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (out->write_errno_ == 0) out->write_errno_ = n < 0 ? errno : EIO;
+      errno = out->write_errno_;
+      return 0;  // fopencookie: 0 is an error, stdio sets the stream's error flag
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return static_cast<long>(done);
+}
+
+int AtomicOutputFile::close_fd(void* self) {
+  auto* out = static_cast<AtomicOutputFile*>(self);
+  const int rc = out->fd_ >= 0 ? ::close(out->fd_) : 0;
+  out->fd_ = -1;
+  return rc;
 }
 
 void AtomicOutputFile::abandon() {

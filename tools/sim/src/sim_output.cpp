@@ -6,6 +6,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/carmen_writer.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/output_set.h"
 
 namespace sdpslam::sim {
 namespace {
@@ -92,8 +93,11 @@ OutputStatus simulate_to_directory(const World& world, const std::string& world_
     *error = "map resolution must be > 0 m";
     return OutputStatus::kBadOptions;
   }
-  if (!io::make_directories(dir, error)) return OutputStatus::kIoError;
-  const OutputFiles files = output_files(dir);
+  // Made, cleaned of an interrupted run's leftovers and proven writable before the
+  // simulation; every file is staged and delivered as one set at the end.
+  io::OutputSet set;
+  if (!set.begin(dir.empty() ? std::string(".") : dir, error)) return OutputStatus::kIoError;
+  const OutputFiles files = output_files(set.staging_dir());
 
   io::CarmenWriter writer;
   if (!writer.open(files.log, error)) return OutputStatus::kIoError;
@@ -113,6 +117,7 @@ OutputStatus simulate_to_directory(const World& world, const std::string& world_
   const io::OccupancyImage map = rasterize_world(world, raster);
   if (!io::write_map_pgm_yaml(files.map_stem, map, io::MapWriteOptions{}, error)) return OutputStatus::kIoError;
   if (!io::write_map_png(files.map_png, map, outputs->ground_truth, error)) return OutputStatus::kIoError;
+  if (!set.commit(error)) return OutputStatus::kIoError;
   return OutputStatus::kOk;
 }
 

@@ -12,6 +12,7 @@
 #include "sdpslam/core/dpslam_filter.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/output_set.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
@@ -43,7 +44,10 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   }
   io::LogReader reader;
   if (!reader.open(log_path, options.config.log, error)) return RunStatus::kBadInput;
-  if (!io::make_directories(out_dir, error)) return RunStatus::kIoError;
+  // The output folder is made, cleaned of an interrupted run's leftovers and proven
+  // writable before any work; every file is staged and delivered as one set at the end.
+  io::OutputSet outputs;
+  if (!outputs.begin(out_dir, error)) return RunStatus::kIoError;
 
   const std::size_t arena_bytes = DpSlamFilter::required_arena_bytes(fo);
   std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
@@ -90,7 +94,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   const DpMap& map = filter->map();
   io::OccupancyImage image;
   const std::uint32_t known_cells = best_map_image(*filter, &image);
-  if (!write_trajectory_and_map(out_dir, trajectory, image, error)) return RunStatus::kIoError;
+  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error)) return RunStatus::kIoError;
 
   // stats.json: deterministic fields first, timing apart.
   const AncestryTree& tree = filter->tree();
@@ -140,7 +144,8 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
         fmt("%.3f", percentile(scan_cpu_ms, 1.0)) + ", \"cpu_time_s\": " +
         fmt("%.3f", rusage_cpu_s(ru)) + ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) +
         "}\n}\n";
-  if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return RunStatus::kIoError;
+  if (!io::write_file_atomic(outputs.path("stats.json"), js, error)) return RunStatus::kIoError;
+  if (!outputs.commit(error)) return RunStatus::kIoError;
 
   if (summary != nullptr) {
     summary->scans = scans.size();

@@ -17,6 +17,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/log_reader.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/output_set.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
@@ -268,7 +269,10 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   }
   io::LogReader reader;
   if (!reader.open(log_path, options.config.log, error)) return SdpRunStatus::kBadInput;
-  if (!io::make_directories(out_dir, error)) return SdpRunStatus::kIoError;
+  // The output folder is made, cleaned of an interrupted run's leftovers and proven
+  // writable before any work; every file is staged and delivered as one set at the end.
+  io::OutputSet outputs;
+  if (!outputs.begin(out_dir, error)) return SdpRunStatus::kIoError;
 
   // The whole state: one arena sized at init (the fixed memory budget).
   const std::size_t arena_bytes = SdpSlam::required_arena_bytes(fo, options.sdp);
@@ -333,7 +337,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
 
   io::OccupancyImage image;
   const std::uint32_t known_cells = sdp_global_map_image(*slam, &image);
-  if (!write_trajectory_and_map(out_dir, trajectory, image, error)) return SdpRunStatus::kIoError;
+  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error)) return SdpRunStatus::kIoError;
   std::string csv = "stamp_s,mean_m,std_m,samples\n";
   for (const Row& r : rows.rows) {
     char line[128];
@@ -341,8 +345,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
                   r.samples);
     csv += line;
   }
-  if (!io::write_file_atomic(out_dir + "/icp_error.csv", csv, error)) return SdpRunStatus::kIoError;
-  if (!write_error_plot(out_dir + "/icp_error.png", rows.rows, scans.front().stamp_us, scans.back().stamp_us, error)) {
+  if (!io::write_file_atomic(outputs.path("icp_error.csv"), csv, error)) return SdpRunStatus::kIoError;
+  if (!write_error_plot(outputs.path("icp_error.png"), rows.rows, scans.front().stamp_us, scans.back().stamp_us, error)) {
     return SdpRunStatus::kIoError;
   }
 
@@ -383,7 +387,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
         ", \"scan_cpu_ms_max_bottom_idle\": " + fmt("%.3f", cpu_max_bottom_idle) +
         ", \"scans_cpu_over_100ms\": " + u(scans_cpu_over_100ms) + ", \"peak_rss_kib\": " +
         u(static_cast<std::uint64_t>(ru.ru_maxrss)) + "}\n}\n";
-  if (!io::write_file_atomic(out_dir + "/stats.json", js, error)) return SdpRunStatus::kIoError;
+  if (!io::write_file_atomic(outputs.path("stats.json"), js, error)) return SdpRunStatus::kIoError;
+  if (!outputs.commit(error)) return SdpRunStatus::kIoError;
 
   if (summary != nullptr) {
     summary->scans = scans.size();

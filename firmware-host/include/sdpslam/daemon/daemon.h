@@ -44,6 +44,7 @@
 #include "sdpslam/hal/clock.h"
 #include "sdpslam/hal/range_scan_source.h"
 #include "sdpslam/hal/wheel_encoder_source.h"
+#include "sdpslam/io/output_set.h"
 
 namespace sdpslam::daemon {
 
@@ -60,6 +61,7 @@ struct DaemonCounters {
   std::uint64_t odometry_stale_events = 0U;
   std::uint64_t output_writes = 0U;
   std::uint64_t output_failures = 0U;
+  std::uint64_t output_writes_unchanged = 0U;  // periods with no new scan: nothing rewritten
   std::int64_t max_output_write_us = 0;
   std::int64_t max_odometry_wait_us = 0;     // longest a placed scan waited for odometry
   std::uint64_t scans_dropped() const {
@@ -137,6 +139,8 @@ class Daemon {
   RingBuffer<PendingScan, DaemonConfig::kMaxScanQueue> queue_;
   RangeScan scratch_;
   InputRecorder recorder_;
+  io::OutputSet outputs_;  // trajectory and map, delivered together (manifest.txt)
+  std::uint64_t written_at_scans_ = ~std::uint64_t{0};  // scans_placed at the last delivered set
   RangeScan slam_scan_;  // the placed scan as SLAM gets it (InputRecorder::pass)
   PendingScan pending_scratch_;
   DaemonCounters counters_;

@@ -3,6 +3,7 @@
 // fsync, rename over the target (and fsync the directory). A reader of `path` sees
 // either the old complete file or the new complete file, never a torn one, even if the
 // process dies mid-write.
+#include <cstddef>
 #include <cstdio>
 #include <string>
 
@@ -32,7 +33,14 @@ class AtomicOutputFile {
   void abandon();
 
  private:
+  // The stream writes through write(2) on fd_ and keeps the first error's errno (stdio
+  // does not), so a full disk is reported as "No space left on device".
+  static long write_to_fd(void* self, const char* data, std::size_t size);
+  static int close_fd(void* self);
+
   std::FILE* file_ = nullptr;
+  int fd_ = -1;
+  int write_errno_ = 0;
   std::string path_;
   std::string temp_path_;
 };
