@@ -54,7 +54,7 @@ std::int64_t CandumpReplayBus::next_due_us() const {
 int CandumpReplayBus::send(const hal::CanFrame& frame) {
   (void)frame;
   if (state_ == hal::CanBusState::kDown) {
-    ++stats_.tx_errors;
+    ++stats_.tx_while_down;
     return -1;
   }
   ++stats_.tx_frames;

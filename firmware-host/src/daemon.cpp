@@ -345,7 +345,8 @@ std::string Daemon::status_json() const {
     js += "  \"can\": {\"rx_frames\": " + u(cs.rx_frames) + ", \"tx_frames\": " + u(cs.tx_frames) +
           ", \"rx_overflows\": " + u(cs.rx_overflows) + ", \"error_frames\": " + u(cs.error_frames) +
           ", \"bus_off\": " + u(cs.errors.bus_off) + ", \"down_count\": " + u(cs.down_count) +
-          ", \"reopen_count\": " + u(cs.reopen_count) + ", \"tx_errors\": " + u(cs.tx_errors) + "},\n";
+          ", \"reopen_count\": " + u(cs.reopen_count) + ", \"tx_errors\": " + u(cs.tx_errors) +
+          ", \"tx_while_down\": " + u(cs.tx_while_down) + "},\n";
   }
   const InputRecorderStats& rs = recorder_.stats();
   js += "  \"input_log\": {\"enabled\": " + std::string(recorder_.is_open() ? "true" : "false") + ", \"lines\": " +

@@ -180,8 +180,9 @@ int run_daemon(int argc, char** argv) {
     }
     auto sb = std::make_unique<drivers::SocketCanBus>(so, clock);
     if (sb->state() == hal::CanBusState::kDown) {
-      log.log(daemon::Event::kCan, "CAN %s cannot be opened now (%s, errno %d): retrying every %.1f s",
-              config.can_interface.c_str(), drivers::to_string(sb->last_error()), sb->last_errno(),
+      char cause[160];
+      log.log(daemon::Event::kCan, "CAN %s cannot be opened now: %s; retrying every %.1f s",
+              config.can_interface.c_str(), sb->describe_last_failure(cause, sizeof cause),
               static_cast<double>(config.can_reopen_interval_us) * 1e-6);
     }
     bus = std::move(sb);

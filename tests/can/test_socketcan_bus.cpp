@@ -6,7 +6,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <string>
 
 #include "can_test_support.h"
 #include "sdpslam/drivers/linux_clock.h"
@@ -222,6 +224,16 @@ TEST(SocketCanBus, missing_interface_starts_down_and_retries_at_most_every_inter
   hal::CanFrame f;
   LONGS_EQUAL(-1, bus.receive(f));
   LONGS_EQUAL(-1, bus.send(f));
+  LONGS_EQUAL(-1, bus.send(f));
+  // Sends refused while down are not errors: the bus going down is the event.
+  LONGS_EQUAL(0, bus.stats().tx_errors);
+  LONGS_EQUAL(2, bus.stats().tx_while_down);
+  LONGS_EQUAL(1, bus.stats().down_count);
+  // The cause in words: this machine either has no CAN in its kernel or no such interface.
+  char cause[160];
+  const std::string text = bus.describe_last_failure(cause, sizeof cause);
+  CHECK_TEXT(text.find("interface sdpnocan9 does not exist") == 0 || text.find("the kernel has no CAN support") == 0,
+             text.c_str());
   LONGS_EQUAL(0, bus.stats().reopen_attempts);  // interval not yet elapsed
   clock.t_us += 500000;
   LONGS_EQUAL(-1, bus.receive(f));
@@ -250,4 +262,16 @@ TEST(SocketCanBus, kernel_receive_stamp_is_mapped_onto_the_monotonic_clock) {
   CHECK_TRUE(got.stamp_us != clock.t_us);
   // Allow for the realtime/monotonic offset being sampled a moment later.
   CHECK_TRUE(got.stamp_us >= before - 2000 && got.stamp_us <= after + 2000);
+}
+
+TEST(SocketCanBus, failure_causes_are_named_in_words) {
+  char out[160];
+  STRCMP_CONTAINS("the kernel has no CAN support",
+                  describe_failure(SocketCanError::kOs, EAFNOSUPPORT, "can0", out, sizeof out));
+  STRCMP_CONTAINS("interface can1 does not exist",
+                  describe_failure(SocketCanError::kNoInterface, ENODEV, "can1", out, sizeof out));
+  STRCMP_CONTAINS("interface can0 is down", describe_failure(SocketCanError::kDown, ENETDOWN, "can0", out, sizeof out));
+  STRCMP_CONTAINS("Permission denied", describe_failure(SocketCanError::kOs, EACCES, "can0", out, sizeof out));
+  char tiny[8];
+  STRCMP_EQUAL("the ker", describe_failure(SocketCanError::kOs, EAFNOSUPPORT, "can0", tiny, sizeof tiny));
 }

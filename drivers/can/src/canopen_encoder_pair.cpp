@@ -29,7 +29,7 @@ int CanOpenEncoderPair::send_nmt_start(std::uint8_t node) {
   if (!canopen::make_nmt(canopen::NmtCommand::kStart, node, f)) return -1;
   const int r = bus_.send(f);
   if (r > 0) stats_.nmt_sent++;
-  if (r < 0) stats_.tx_errors++;
+  if (r < 0 && bus_.state() != hal::CanBusState::kDown) stats_.tx_errors++;  // down: the bus counts it
   return r;
 }
 
@@ -60,8 +60,8 @@ void CanOpenEncoderPair::produce_sync(std::int64_t now_us) {
   }
   if (r > 0) {
     stats_.sync_sent++;
-  } else {
-    stats_.tx_errors++;
+  } else if (bus_.state() != hal::CanBusState::kDown) {
+    stats_.tx_errors++;  // while down, the bus counts the refusals (CanBusStats::tx_while_down)
   }
   // Keep the grid of the schedule (no drift); periods that passed entirely are skipped.
   next_sync_us_ += options_.sync_period_us;

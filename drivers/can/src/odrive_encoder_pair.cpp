@@ -81,7 +81,7 @@ void ODriveEncoderPair::request(std::int64_t now_us) {
     const int r = bus_.send(f);
     if (r > 0) stats_.requests_sent++;
     if (r == 0) stats_.request_try_later++;
-    if (r < 0) stats_.tx_errors++;
+    if (r < 0 && bus_.state() != hal::CanBusState::kDown) stats_.tx_errors++;  // down: the bus counts it
   }
   next_request_us_ += options_.request_period_us;
   if (next_request_us_ <= now_us) next_request_us_ = now_us + options_.request_period_us;

@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstring>
 
 #include "sdpslam/drivers/linux_clock.h"
@@ -47,6 +48,28 @@ bool is_down_errno(int e) { return e == ENETDOWN || e == ENXIO || e == ENODEV; }
 bool is_peer_closed_errno(int e) { return e == EPIPE || e == ECONNRESET || e == ENOTCONN; }
 
 }  // namespace
+
+const char* describe_failure(SocketCanError e, int err, const char* interface_name, char* out, std::size_t size) {
+  if (out == nullptr || size == 0U) return "";
+  const char* name = interface_name != nullptr ? interface_name : "?";
+  if (e == SocketCanError::kOs && (err == EAFNOSUPPORT || err == EPROTONOSUPPORT)) {
+    std::snprintf(out, size, "the kernel has no CAN support (load the can and can_raw modules: modprobe can_raw)");
+  } else if (e == SocketCanError::kNoInterface && (err == ENODEV || err == ENXIO)) {
+    std::snprintf(out, size,
+                  "interface %s does not exist (see `ip link`; is the adapter plugged in and its driver loaded?)", name);
+  } else if (e == SocketCanError::kDown || (e == SocketCanError::kOs && is_down_errno(err))) {
+    std::snprintf(out, size, "interface %s is down (ip link set %s up type can bitrate N)", name, name);
+  } else if (e == SocketCanError::kPeerClosed) {
+    std::snprintf(out, size, "the other end of the CAN socket closed");
+  } else if (e == SocketCanError::kBadLength) {
+    std::snprintf(out, size, "a datagram on %s was not one CAN frame", name);
+  } else if (e == SocketCanError::kNone) {
+    std::snprintf(out, size, "no error");
+  } else {
+    std::snprintf(out, size, "%s on %s: %s", to_string(e), name, std::strerror(err));
+  }
+  return out;
+}
 
 SocketCanBus::SocketCanBus(const SocketCanOptions& options, const hal::MonotonicClock& clock)
     : options_(options), clock_(clock) {
@@ -180,7 +203,7 @@ bool SocketCanBus::passes_filter(const hal::CanFrame& f) const {
 
 int SocketCanBus::send(const hal::CanFrame& frame) {
   if (!maybe_reopen()) {
-    stats_.tx_errors++;
+    stats_.tx_while_down++;  // the bus going down is the event (down_count), not each retry
     return -1;
   }
   if (frame.dlc > hal::CanFrame::kMaxDataBytes || frame.is_error()) {

@@ -78,7 +78,8 @@ struct CanBusStats {
   std::uint64_t tx_frames = 0;
   std::uint64_t rx_frames = 0;         // data/RTR frames delivered to the caller
   std::uint64_t tx_try_later = 0;      // send() returned 0 (ENOBUFS / EAGAIN)
-  std::uint64_t tx_errors = 0;         // send() returned < 0
+  std::uint64_t tx_errors = 0;         // frames refused on an open bus (bad frame, kernel error)
+  std::uint64_t tx_while_down = 0;     // send() calls refused while the bus was down
   std::uint64_t rx_errors = 0;         // receive() returned < 0 (bad length excluded)
   std::uint64_t rx_overflows = 0;      // frames the kernel dropped (SO_RXQ_OVFL)
   std::uint64_t rx_filtered = 0;       // frames dropped by the software id filter

@@ -22,6 +22,7 @@
 // re-opened. The object closes the fd it owns (adopted ones too) on destruction.
 //
 // Memory: fixed; no heap. Not thread-safe (one owner thread).
+#include <cstddef>
 #include <cstdint>
 
 #include "sdpslam/hal/can_bus.h"
@@ -57,6 +58,12 @@ enum class SocketCanError : std::uint8_t {
 };
 const char* to_string(SocketCanError e);
 
+// The cause of a failure in words a robot builder can act on, written to `out` (always
+// terminated): "the kernel has no CAN support ..." (socket(PF_CAN) refused),
+// "interface can0 does not exist ...", "interface can0 is down ...", or the error's
+// strerror text. Returns `out`.
+const char* describe_failure(SocketCanError e, int err, const char* interface_name, char* out, std::size_t size);
+
 class SocketCanBus final : public hal::CanBus {
  public:
   // Opens `options.interface_name` at once; on failure the bus starts in kDown and
@@ -79,6 +86,10 @@ class SocketCanBus final : public hal::CanBus {
 
   SocketCanError last_error() const { return last_error_; }
   int last_errno() const { return last_errno_; }
+  // describe_failure() of the last error, for this interface.
+  const char* describe_last_failure(char* out, std::size_t size) const {
+    return describe_failure(last_error_, last_errno_, options_.interface_name, out, size);
+  }
   bool adopted() const { return adopted_; }
   int fd() const { return fd_; }
   // True iff the kernel accepted CAN_RAW_FILTER / SO_TIMESTAMP / SO_RXQ_OVFL on this fd.
