@@ -26,8 +26,9 @@ bool parse_sdp_profile(const char* text, SdpProfile* profile) {
 }
 
 void apply_profile(SdpProfile profile, DpSlamOptions* bottom, SdpOptions* top) {
-  // kPaper is the declared defaults: it names no field, so a file's keys and anything the
-  // caller already set stay as they are.
+  // Both profiles: the paper's B (§IV, 60T/10B). kPaper names no other field, so a file's
+  // keys and anything the caller already set stay as they are.
+  if (bottom != nullptr) bottom->particle_count = kSdpBottomParticles;
   if (profile != SdpProfile::kAccurate) return;
   if (bottom != nullptr) {
     // Improved proposal; 8 beams per match candidate keeps 10 particles inside the CPU

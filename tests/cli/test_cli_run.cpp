@@ -174,3 +174,55 @@ TEST(CliRun, outputs_are_one_run_s_set) {
   CHECK_TEXT(m2.str().find("icp_error") == std::string::npos, m2.str().c_str());
   STRCMP_CONTAINS(" stats.json\n", m2.str().c_str());
 }
+
+namespace {
+
+std::string slurp_without_timing(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find("\"timing\"") == std::string::npos && line.find(" stats.json") == std::string::npos) {
+      out += line + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// tools/slam/default.ini documents the defaults: given as --config it changes nothing, in
+// either mode (sdp mode's profile keys and the mode's particle count are left out of it).
+TEST(CliRun, the_shipped_default_ini_changes_nothing) {
+  Run r = run_cli("simulate --max-duration 15 --out " + dir + "/sim");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  for (const char* mode : {"sdp", "dpslam"}) {
+    const std::string base = "run " + dir + "/sim/sim.clf --mode " + mode + " --seed 3 --out " + dir;
+    r = run_cli(base + "/plain");
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    r = run_cli(base + "/documented --config " + SDPSLAM_DEFAULT_INI);
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    for (const char* file : {"trajectory.txt", "map.pgm", "stats.json", "manifest.txt"}) {
+      const std::string a = slurp_without_timing(dir + "/plain/" + file);
+      const std::string b = slurp_without_timing(dir + "/documented/" + file);
+      CHECK_TEXT(!a.empty(), file);
+      CHECK_TEXT(a == b, (std::string(mode) + ": " + file + " differs with the documented defaults").c_str());
+    }
+  }
+}
+
+// [filter] particles is the bottom level's B in sdp mode too (it used to be ignored
+// there without a word); --particles still overrides it.
+TEST(CliRun, filter_particles_is_honoured_in_sdp_mode) {
+  const std::string log = log_with_bad_lines(0);
+  const std::string ini = put("b.ini", "[filter]\nparticles = 12\n");
+  Run r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("\"bottom_particles\": 12,", slurp_without_timing(dir + "/a/stats.json").c_str());
+  r = run_cli("run " + log + " --config " + ini + " --particles 7 --out " + dir + "/b");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("\"bottom_particles\": 7,", slurp_without_timing(dir + "/b/stats.json").c_str());
+  r = run_cli("run " + log + " --out " + dir + "/c");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("\"bottom_particles\": 10,", slurp_without_timing(dir + "/c/stats.json").c_str());
+}

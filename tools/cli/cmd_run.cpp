@@ -20,7 +20,7 @@ namespace {
 struct RunArgs {
   std::string log;
   std::string mode = "sdp";
-  std::uint32_t particles = 0U;      // 0 = dpslam: from the config; sdp: 10
+  std::uint32_t particles = 0U;      // 0 = from the config (sdp: the profile's 10 unless the file says)
   std::uint32_t top_particles = 0U;  // 0 = from the sdp config (60)
   std::string topology;
   std::string profile;               // empty = kDefaultSdpProfile
@@ -28,8 +28,6 @@ struct RunArgs {
   std::uint64_t seed = 1U;
   std::string out;
 };
-
-constexpr std::uint32_t kSdpDefaultBottomParticles = 10U;  // paper §IV, "60T/10B"
 
 int report(const char* what, int code, const std::string& error) {
   std::fprintf(stderr, "sdpslam run: %s%s\n", what, error.c_str());
@@ -73,7 +71,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   if (!a.config.empty() && !slam::load_sdp_ini(a.config, &ro.sdp, &error)) {
     return report("", kExitBadInput, error);
   }
-  ro.config.filter.particle_count = a.particles != 0U ? a.particles : kSdpDefaultBottomParticles;
+  if (a.particles != 0U) ro.config.filter.particle_count = a.particles;  // else the profile's B or the file's
   if (a.top_particles != 0U) ro.sdp.top_particles = a.top_particles;
   if (!a.topology.empty()) {
     if (slam::apply_sdp_key(&ro.sdp, "topology", a.topology.c_str(), &error) != slam::SdpKeyResult::kApplied) {
@@ -144,7 +142,7 @@ std::function<int()> setup_run(CLI::App& app) {
       ->check(CLI::IsMember({"sdp", "dpslam"}))
       ->capture_default_str();
   app.add_option("--particles", args->particles,
-                 "Bottom-level particles (sdp: default 10; dpslam: overrides [filter] particles)");
+                 "Bottom-level particles, over [filter] particles (default: sdp 10, dpslam 30)");
   app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)");
   app.add_option("--topology", args->topology, "sdp: topology estimation, sdp (default) or segslam (local analysis)")
       ->check(CLI::IsMember({"sdp", "segslam"}));

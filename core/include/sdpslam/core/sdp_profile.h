@@ -2,8 +2,10 @@
 // Named starting points for SDP-SLAM's options: what `sdpslam run` (sdp mode) and sdpslamd
 // (mode = sdp) begin from before a configuration file's keys are applied.
 //
-//  kPaper    — the paper's algorithm (SDP-SLAM §III): DpSlamOptions{} and SdpOptions{}
-//              as declared: odometry proposals in the bottom level, no loop closure.
+//  Both      — kSdpBottomParticles bottom-level particles, the B of the paper's 60T/10B
+//              (§IV); DP-SLAM alone (mode dpslam) keeps DpSlamOptions' 30.
+//  kPaper    — the paper's algorithm (SDP-SLAM §III): otherwise DpSlamOptions{} and
+//              SdpOptions{} as declared: odometry proposals, no loop closure.
 //  kAccurate — the default of the tools and the onboard program, judged by the accuracy
 //              benchmark over every log and built-in world (tools/bench/accuracy.sh,
 //              worst seed). Beyond the paper:
@@ -26,6 +28,9 @@
 namespace sdpslam {
 
 enum class SdpProfile : std::uint8_t { kPaper, kAccurate };
+
+// Bottom-level particles per segment in sdp mode (both profiles).
+constexpr std::uint32_t kSdpBottomParticles = 10U;
 
 // The profile the tools and sdpslamd use when none is named.
 constexpr SdpProfile kDefaultSdpProfile = SdpProfile::kAccurate;

@@ -40,7 +40,9 @@ const char* to_string(SlamMode m);
 struct DaemonConfig {
   // [can]
   std::string can_interface = "can0";
-  drivers::CanWheelEncoderConfig encoders;
+  // The documented defaults (sdpslamd.ini): nodes 1 and 2 for either protocol, and
+  // sdpslamd produces the CANopen SYNC every 10 ms.
+  drivers::CanWheelEncoderConfig encoders = default_encoders();
   std::int64_t can_reopen_interval_us = 500000;
   // [laser]
   std::string laser_device = "/dev/ttyACM0";
@@ -83,6 +85,16 @@ struct DaemonConfig {
   std::uint32_t memory_budget_mib = 128U;
 
   static constexpr std::uint32_t kMaxScanQueue = 16U;
+
+  static drivers::CanWheelEncoderConfig default_encoders() {
+    drivers::CanWheelEncoderConfig e;
+    e.canopen.left_node = 1U;
+    e.canopen.right_node = 2U;
+    e.canopen.sync_period_us = 10000;
+    e.odrive.left_node = 1U;
+    e.odrive.right_node = 2U;
+    return e;
+  }
 };
 
 // Applies the keys of `path` on top of *config. False iff the file cannot be read, a line
