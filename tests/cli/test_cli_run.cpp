@@ -226,3 +226,16 @@ TEST(CliRun, filter_particles_is_honoured_in_sdp_mode) {
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   STRCMP_CONTAINS("\"bottom_particles\": 10,", slurp_without_timing(dir + "/c/stats.json").c_str());
 }
+
+// Top-level options given to DP-SLAM alone are refused (flags) or warned about (a
+// config's [sdp] section), never silently ignored.
+TEST(CliRun, top_level_options_in_dpslam_mode_are_not_ignored_silently) {
+  const std::string log = log_with_bad_lines(0);
+  Run r = run_cli("run " + log + " --mode dpslam --top-particles 20 --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--top-particles and --topology apply to --mode sdp", r.out.c_str());
+  const std::string ini = put("s.ini", "[filter]\nparticles = 12\n\n[sdp]\ntop_particles = 20\n");
+  r = run_cli("run " + log + " --mode dpslam --config " + ini + " --out " + dir + "/b");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS((ini + ": [sdp] keys have no effect in --mode dpslam").c_str(), r.out.c_str());
+}

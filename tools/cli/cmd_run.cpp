@@ -6,6 +6,7 @@
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
 // dpslam: the bottom-level DP-SLAM filter alone, the baseline (tools/slam/run_offline.h).
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -32,6 +33,23 @@ struct RunArgs {
 int report(const char* what, int code, const std::string& error) {
   std::fprintf(stderr, "sdpslam run: %s%s\n", what, error.c_str());
   return code;
+}
+
+// Whether the INI file has a `[name]` section (the file was read whole before: a read
+// failure here only means no warning).
+bool ini_has_section(const std::string& path, const char* name) {
+  std::FILE* f = std::fopen(path.c_str(), "r");
+  if (f == nullptr) return false;
+  const std::string want = std::string("[") + name + "]";
+  char line[512];
+  bool found = false;
+  while (!found && std::fgets(line, sizeof line, f) != nullptr) {
+    const char* p = line;
+    while (*p == ' ' || *p == '\t') ++p;
+    found = std::strncmp(p, want.c_str(), want.size()) == 0;
+  }
+  std::fclose(f);
+  return found;
 }
 
 // The log reader's repairs of odometry that ran against the log's own velocity
@@ -156,8 +174,12 @@ std::function<int()> setup_run(CLI::App& app) {
   app.add_option("--out", args->out, "Output directory")->required();
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
+    // Options of the top level mean nothing to DP-SLAM alone: refused, not ignored.
     if (!sdp && !args->profile.empty()) {
       return report("", kExitUsage, "--profile applies to --mode sdp (dpslam starts from tools/slam/default.ini)");
+    }
+    if (!sdp && (args->top_particles != 0U || !args->topology.empty())) {
+      return report("", kExitUsage, "--top-particles and --topology apply to --mode sdp");
     }
     SdpProfile profile = kDefaultSdpProfile;
     if (!args->profile.empty()) (void)parse_sdp_profile(args->profile.c_str(), &profile);  // checked by CLI11
@@ -167,6 +189,10 @@ std::function<int()> setup_run(CLI::App& app) {
     std::string error;
     if (!args->config.empty() && !slam::load_config_ini(args->config, &config, &error)) {
       return report("", kExitBadInput, error);
+    }
+    if (!sdp && !args->config.empty() && ini_has_section(args->config, "sdp")) {
+      std::fprintf(stderr, "sdpslam run: warning: %s: [sdp] keys have no effect in --mode dpslam\n",
+                   args->config.c_str());
     }
     return sdp ? run_sdp_mode(*args, config, sdp_options, profile) : run_dpslam_mode(*args, config);
   };
