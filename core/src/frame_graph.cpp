@@ -63,6 +63,22 @@ bool inverse3(const double* m, double* out) {
   return true;
 }
 // eᵀ Ω e.
+// The loops' robust kernel: Dynamic Covariance Scaling (Agarwal et al., ICRA 2013) with
+// Φ = c². A loop keeps its full information while χ² <= Φ; beyond, its information is
+// scaled by s² with s = 2Φ / (Φ + χ²), so the pull of a loop (w·sqrt(χ²)) falls off as
+// 1/χ³ instead of the Cauchy kernel's 1/χ: a false loop metres away pulls nearly nothing,
+// where under Cauchy it kept most of an inlier's pull. c² = kNoKernel: weight 1.
+double kernel_weight(double x2, double c2) {
+  if (!(c2 < FrameGraph::kNoKernel) || x2 <= c2) return 1.0;
+  const double s = 2.0 * c2 / (c2 + x2);
+  return s * s;
+}
+// The cost whose derivative in χ² is kernel_weight(): χ² up to Φ, 3Φ − 4Φ²/(Φ + χ²) beyond.
+double kernel_cost(double x2, double c2) {
+  if (!(c2 < FrameGraph::kNoKernel) || x2 <= c2) return x2;
+  return 3.0 * c2 - 4.0 * c2 * c2 / (c2 + x2);
+}
+
 double weighted_sq(const FrameInfo& info, const double* e) {
   return info.xx * e[0] * e[0] + 2.0 * info.xy * e[0] * e[1] + info.yy * e[1] * e[1] + info.theta * e[2] * e[2];
 }
@@ -294,15 +310,12 @@ void FrameGraph::optimise() {
   double* hp = work_ + 4U * m;
   // work_ + 15·max_nodes .. 18·max_nodes: the preconditioner's y (see precondition()).
   const std::size_t dim = 3U * n_;
-  // The objective: Σ χ² of the chain + Σ c² ln(1 + χ²/c²) of the loops (Cauchy, c per
-  // loop; χ² for a loop without a kernel).
+  // The objective: Σ χ² of the chain + Σ kernel_cost(χ²) of the loops (χ² for a loop
+  // without a kernel).
   auto total_chi2 = [&]() {
     double s = 0.0;
     for (std::uint32_t k = 1; k < n_; ++k) s += chi2(seq_[k]);
-    for (std::uint32_t q = 0; q < loops_; ++q) {
-      const double x2 = chi2(loop_[q]);
-      s += loop_[q].c2 < kNoKernel ? loop_[q].c2 * det::log(1.0 + x2 / loop_[q].c2) : x2;
-    }
+    for (std::uint32_t q = 0; q < loops_; ++q) s += kernel_cost(chi2(loop_[q]), loop_[q].c2);
     return s;
   };
   stats_.last_chi2_before = total_chi2();
@@ -311,7 +324,7 @@ void FrameGraph::optimise() {
     for (std::uint32_t q = 0; q < loops_; ++q) {
       Linear& l = lin_[options_.max_nodes + q];
       linearise(loop_[q], l);
-      l.w = 1.0 / (1.0 + weighted_sq(loop_[q].info, l.e) / loop_[q].c2);
+      l.w = kernel_weight(weighted_sq(loop_[q].info, l.e), loop_[q].c2);
       loop_w_[q] = l.w;
     }
     // b = Σ Jᵀ Ω e; r = −b (Δ = 0 to start).
@@ -368,7 +381,7 @@ void FrameGraph::optimise() {
   }
   std::uint32_t down = 0U;
   for (std::uint32_t q = 0; q < loops_; ++q) {
-    loop_w_[q] = 1.0 / (1.0 + chi2(loop_[q]) / loop_[q].c2);
+    loop_w_[q] = kernel_weight(chi2(loop_[q]), loop_[q].c2);
     if (loop_w_[q] < 0.5) ++down;
   }
   stats_.last_chi2_after = total_chi2();

@@ -12,9 +12,13 @@
 // chain's own transform T_(k-1)k, Fig. 3 (l)); LOOP constraints join any two nodes with
 // the relative pose ICP found. The error of a constraint (i, j, Z, Ω) is
 //   e = t2v(Z⁻¹ ⊕ (X_i⁻¹ ⊕ X_j)),  cost ½ eᵀ Ω e,  Ω = diag(1/σ_xy², 1/σ_xy², 1/σ_θ²).
-// Loop constraints pass through a Cauchy kernel (weight 1 / (1 + χ²/c²), χ² = eᵀΩe,
-// recomputed every Gauss-Newton step), so a wrong match that disagrees with the rest
-// pulls little; a loop verified before it was added may go without one (kNoKernel).
+// Loop constraints pass through Dynamic Covariance Scaling (Agarwal et al., "Robust Map
+// Optimization using Dynamic Covariance Scaling", ICRA 2013): with χ² = eᵀΩe and Φ = c²,
+// a loop keeps its information while χ² <= Φ and is scaled by s², s = 2Φ / (Φ + χ²),
+// beyond (recomputed every Gauss-Newton step). Its pull falls off as 1/χ³, so a wrong
+// match metres away from the rest pulls almost nothing (a Cauchy kernel's falls off only
+// as 1/χ: a false loop kept most of an inlier's pull). A loop verified before it was
+// added may go without a kernel (kNoKernel).
 //
 // Solver: Gauss-Newton on the poses (additive update of x, y, θ). Each step solves
 // H Δ = -b by preconditioned conjugate gradients; H is never formed, H·v is summed over
@@ -37,7 +41,7 @@ struct FrameGraphOptions {
   std::uint32_t max_loops = 256U;  // loop constraints per solve, >= 1
   std::uint32_t iterations = 5U;   // Gauss-Newton steps, >= 1
   std::uint32_t cg_iterations = 30U;  // conjugate-gradient iterations per step, >= 1
-  double robust_chi = 3.0;  // Cauchy kernel scale on sqrt(χ²) of loop constraints, > 0
+  double robust_chi = 3.0;  // kernel scale c on sqrt(χ²) of loop constraints (Φ = c²), > 0
   bool valid() const {
     return max_nodes >= 2U && max_loops >= 1U && iterations >= 1U && cg_iterations >= 1U && robust_chi > 0.0;
   }
@@ -76,7 +80,7 @@ struct FrameGraphStats {
   std::uint64_t solves = 0U;
   std::uint64_t refused_nodes = 0U;  // add_node beyond max_nodes
   std::uint64_t refused_loops = 0U;  // add_loop beyond max_loops or with bad indices
-  double last_chi2_before = 0.0;     // objective (chain χ² + Cauchy cost of the loops) before / after the last solve
+  double last_chi2_before = 0.0;     // objective (chain χ² + the loops' kernel cost) before / after the last solve
   double last_chi2_after = 0.0;
   std::uint32_t last_downweighted = 0U;  // loops with kernel weight < 0.5 at the end
 };
@@ -94,7 +98,7 @@ class FrameGraph {
   // the information is bad.
   bool add_node(const Pose2& estimate, const Pose2& from_previous, const FrameInfo& info);
   // Loop constraint: `z` is the pose of frame j in frame i (i != j, both added), behind
-  // a Cauchy kernel of scale robust_chi (0 = the options' scale; kNoKernel = plain least
+  // the robust kernel of scale robust_chi (0 = the options' scale; kNoKernel = plain least
   // squares, for a constraint verified before it was added: a kernel would leave a true
   // loop of metres only partly closed). False when full or the indices, the scale or
   // the information (FrameInfo::valid) are bad.
@@ -116,7 +120,7 @@ class FrameGraph {
     std::uint32_t j = 0U;
     Pose2 z;
     FrameInfo info;
-    double c2 = 0.0;  // loops: squared Cauchy scale
+    double c2 = 0.0;  // loops: the kernel's Φ = c²
   };
   // Linearised constraint: e, A = ∂e/∂X_i, B = ∂e/∂X_j (row-major 3×3), weight.
   struct Linear {

@@ -19,7 +19,7 @@
 // submaps still held, then the chosen live submaps, with the chain transforms T of Fig. 3
 // (l) between consecutive ones); finish_adjustment() adds every constraint whose two
 // levels are held and solves (frame_graph.h). The top level's ICP constraints keep a
-// Cauchy kernel; the search's were verified before they were recorded and go without
+// robust kernel (Dynamic Covariance Scaling); the search's were verified before they were recorded and go without
 // one (a kernel would keep a true loop of metres only partly closed).
 //
 // Wide loop search (loop_search_window_m > 0): ICP only sees loops the chain already

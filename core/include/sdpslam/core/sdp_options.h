@@ -109,8 +109,8 @@ struct SdpOptions {
   // most loop_max_correction_m from the chain's placement becomes a constraint between
   // the two frames, and the best combination's frames (permanent ones included) are
   // adjusted to agree with the constraints (pose graph: chain transforms with
-  // segment_sigma_*, loops with loop_sigma_* behind a Cauchy kernel of scale
-  // loop_robust_chi). false (the default) = the paper's top level only; the accurate
+  // segment_sigma_*, loops with loop_sigma_* behind a robust kernel of scale
+  // loop_robust_chi: Dynamic Covariance Scaling, frame_graph.h). false (the default) = the paper's top level only; the accurate
   // profile (sdp_profile.h) turns it on with the wide search below. ICP alone only closes
   // loops the bottom level has kept within its reach, which is why the wide search exists.
   bool loop_closure = false;
