@@ -1,56 +1,27 @@
 // Atomic replacement: the target is either the old or the new complete file, the
 // temporary never survives a failure or an abandon, and errors name the path.
 #include <CppUTest/TestHarness.h>
-#include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
+#include "file_tree.h"
 #include "shared_data.h"
 
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::vector<std::string> list_dir(const std::string& dir) {
-  std::vector<std::string> names;
-  DIR* d = ::opendir(dir.c_str());
-  if (d == nullptr) return names;
-  while (dirent* e = ::readdir(d)) {
-    const std::string n = e->d_name;
-    if (n != "." && n != "..") names.push_back(n);
-  }
-  ::closedir(d);
-  return names;
-}
+using sdpslam::test::list_dir;
+using sdpslam::test::read_file;
+using sdpslam::test::remove_tree;
 
 bool exists(const std::string& path) {
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0;
-}
-
-void remove_tree(const std::string& dir) {
-  for (const std::string& n : list_dir(dir)) {
-    const std::string p = dir + "/" + n;
-    struct stat st {};
-    if (::lstat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-      remove_tree(p);
-    } else {
-      ::unlink(p.c_str());
-    }
-  }
-  ::rmdir(dir.c_str());
 }
 
 }  // namespace
@@ -70,7 +41,7 @@ TEST(AtomicFile, write_creates_file_with_exact_contents) {
   const std::string contents("line 1\nbinary \0 byte\n", 21);
   CHECK_TRUE(sdpslam::io::write_file_atomic(path, contents, &error));
   CHECK_TRUE(error.empty());
-  CHECK(slurp(path) == contents);
+  CHECK(read_file(path) == contents);
   LONGS_EQUAL(1, list_dir(dir).size());
 }
 
@@ -79,7 +50,7 @@ TEST(AtomicFile, write_replaces_existing_target_and_leaves_no_temporary) {
   const std::string path = dir + "/out.txt";
   CHECK_TRUE(sdpslam::io::write_file_atomic(path, "old contents, longer than the new\n", &error));
   CHECK_TRUE(sdpslam::io::write_file_atomic(path, "new\n", &error));
-  STRCMP_EQUAL("new\n", slurp(path).c_str());
+  STRCMP_EQUAL("new\n", read_file(path).c_str());
   const auto names = list_dir(dir);
   LONGS_EQUAL(1, names.size());
   STRCMP_EQUAL("out.txt", names[0].c_str());
@@ -90,7 +61,7 @@ TEST(AtomicFile, empty_contents_give_an_empty_file) {
   const std::string path = dir + "/empty";
   CHECK_TRUE(sdpslam::io::write_file_atomic(path, "", &error));
   CHECK_TRUE(exists(path));
-  LONGS_EQUAL(0, slurp(path).size());
+  LONGS_EQUAL(0, read_file(path).size());
 }
 
 TEST(AtomicFile, write_into_missing_directory_fails_naming_path_and_cause) {
@@ -114,7 +85,7 @@ TEST(AtomicFile, failed_rename_keeps_old_target_and_removes_temporary) {
   CHECK_FALSE(sdpslam::io::write_file_atomic(path, "new contents", &error));
   CHECK(error.find(path) != std::string::npos);
   CHECK(error.find("rename") != std::string::npos);
-  STRCMP_EQUAL("old", slurp(path + "/keep").c_str());
+  STRCMP_EQUAL("old", read_file(path + "/keep").c_str());
   const auto names = list_dir(dir);
   LONGS_EQUAL(1, names.size());
   STRCMP_EQUAL("target", names[0].c_str());
@@ -126,7 +97,7 @@ TEST(AtomicFile, write_under_a_regular_file_fails_and_keeps_that_file) {
   CHECK_TRUE(sdpslam::io::write_file_atomic(blocker, "keep me", &error));
   CHECK_FALSE(sdpslam::io::write_file_atomic(blocker + "/child", "x", &error));
   CHECK(error.find("Not a directory") != std::string::npos);
-  STRCMP_EQUAL("keep me", slurp(blocker).c_str());
+  STRCMP_EQUAL("keep me", read_file(blocker).c_str());
 }
 
 TEST(AtomicFile, streaming_file_is_invisible_until_commit) {
@@ -138,10 +109,10 @@ TEST(AtomicFile, streaming_file_is_invisible_until_commit) {
   CHECK(out.stream() != nullptr);
   for (int i = 0; i < 1000; ++i) std::fprintf(out.stream(), "%d\n", i);
   std::fflush(out.stream());
-  STRCMP_EQUAL("old\n", slurp(path).c_str());
+  STRCMP_EQUAL("old\n", read_file(path).c_str());
   LONGS_EQUAL(2, list_dir(dir).size());  // target + temporary
   CHECK_TRUE(out.commit(&error));
-  const std::string got = slurp(path);
+  const std::string got = read_file(path);
   CHECK(got.rfind("0\n1\n2\n", 0) == 0);
   CHECK(got.size() > 3000);
   LONGS_EQUAL(1, list_dir(dir).size());
@@ -167,7 +138,7 @@ TEST(AtomicFile, abandon_removes_temporary_and_keeps_target) {
   CHECK_TRUE(out.open(path, &error));
   std::fputs("half-written", out.stream());
   out.abandon();
-  STRCMP_EQUAL("old", slurp(path).c_str());
+  STRCMP_EQUAL("old", read_file(path).c_str());
   LONGS_EQUAL(1, list_dir(dir).size());
   CHECK(out.stream() == nullptr);
 }
@@ -201,7 +172,7 @@ TEST(AtomicFile, commit_after_write_error_fails_and_keeps_target) {
   CHECK(std::ferror(out.stream()) != 0);
   CHECK_FALSE(out.commit(&error));
   CHECK(error.find(path) != std::string::npos);
-  STRCMP_EQUAL("old", slurp(path).c_str());
+  STRCMP_EQUAL("old", read_file(path).c_str());
   LONGS_EQUAL(1, list_dir(dir).size());
 }
 
@@ -216,7 +187,7 @@ TEST(AtomicFile, two_open_files_for_same_target_use_distinct_temporaries) {
   std::fputs("B", b.stream());
   CHECK_TRUE(a.commit(&error));
   CHECK_TRUE(b.commit(&error));
-  STRCMP_EQUAL("B", slurp(dir + "/same").c_str());
+  STRCMP_EQUAL("B", read_file(dir + "/same").c_str());
   LONGS_EQUAL(1, list_dir(dir).size());
 }
 

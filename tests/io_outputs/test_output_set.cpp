@@ -2,7 +2,6 @@
 // leaves the previous set whole, leftovers of a killed run are removed, an unwritable
 // folder fails at begin(), and a failed write names its errno.
 #include <CppUTest/TestHarness.h>
-#include <dirent.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -11,51 +10,22 @@
 
 #include <algorithm>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/output_set.h"
+#include "file_tree.h"
 #include "shared_data.h"
 
 namespace {
 
+using sdpslam::test::list_dir;
+using sdpslam::test::read_file;
+using sdpslam::test::remove_tree;
+
 using sdpslam::io::ManifestEntry;
 using sdpslam::io::OutputSet;
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::vector<std::string> list_dir(const std::string& dir) {
-  std::vector<std::string> names;
-  DIR* d = ::opendir(dir.c_str());
-  if (d == nullptr) return names;
-  while (dirent* e = ::readdir(d)) {
-    const std::string n = e->d_name;
-    if (n != "." && n != "..") names.push_back(n);
-  }
-  ::closedir(d);
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-void remove_tree(const std::string& dir) {
-  for (const std::string& n : list_dir(dir)) {
-    const std::string p = dir + "/" + n;
-    struct stat st {};
-    if (::lstat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-      remove_tree(p);
-    } else {
-      ::unlink(p.c_str());
-    }
-  }
-  ::rmdir(dir.c_str());
-}
 
 void put(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
@@ -137,7 +107,7 @@ TEST(OutputSet, a_new_set_replaces_the_previous_one_and_leaves_other_files_alone
   // icp_error.csv belonged to the previous set only: removed. notes.txt was never listed.
   const std::vector<std::string> want = {"manifest.txt", "map.pgm", "notes.txt"};
   CHECK_TRUE(list_dir(dir) == want);
-  STRCMP_EQUAL("new map", slurp(dir + "/map.pgm").c_str());
+  STRCMP_EQUAL("new map", read_file(dir + "/map.pgm").c_str());
   CHECK_TRUE(manifest_names(dir) == std::vector<std::string>{"map.pgm"});
 }
 
@@ -157,7 +127,7 @@ TEST(OutputSet, a_set_abandoned_before_commit_leaves_the_previous_set_whole) {
   }
   const std::vector<std::string> want = {"manifest.txt", "map.pgm", "trajectory.txt"};
   CHECK_TRUE(list_dir(dir) == want);
-  STRCMP_EQUAL("old trajectory", slurp(dir + "/trajectory.txt").c_str());
+  STRCMP_EQUAL("old trajectory", read_file(dir + "/trajectory.txt").c_str());
 }
 
 TEST(OutputSet, a_set_commits_again_for_periodic_outputs) {
@@ -168,7 +138,7 @@ TEST(OutputSet, a_set_commits_again_for_periodic_outputs) {
   CHECK_TRUE(set.commit(&error));
   put(set.path("trajectory.txt"), "two");
   CHECK_TRUE(set.commit(&error));
-  STRCMP_EQUAL("two", slurp(dir + "/trajectory.txt").c_str());
+  STRCMP_EQUAL("two", read_file(dir + "/trajectory.txt").c_str());
   CHECK_TRUE(manifest_names(dir) == std::vector<std::string>{"trajectory.txt"});
 }
 

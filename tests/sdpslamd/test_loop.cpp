@@ -149,6 +149,13 @@ struct Rig {
     enc.sample(ticks, ticks, t);
     d->step();
   }
+  // One scan at t + 50 ms between odometry at t (`ticks`) and t + 100 ms (`ticks` + 100):
+  // placed with an interpolated pose.
+  void scan_between_odometry(std::uint32_t ticks, std::int64_t t) {
+    odom(ticks, t);
+    laser.deliver(t + 50000);
+    odom(ticks + 100U, t + 100000);
+  }
 };
 
 bool file_exists(const std::string& p) {
@@ -307,16 +314,13 @@ TEST(SdpslamdLoop, finish_places_what_it_can_and_writes_outputs_atomically) {
 TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {
   Rig r;
   r.make();
-  r.odom(0, 1000000);
-  r.laser.deliver(1050000);
-  r.odom(100, 1100000);
+  r.scan_between_odometry(0, 1000000);
   CHECK_TRUE(r.d->write_outputs());
   // status.json cannot be replaced while a directory stands in its place.
   const std::string status = r.config.output_directory + "/status.json";
   CHECK_EQUAL(0, std::remove(status.c_str()));
   CHECK_EQUAL(0, ::mkdir(status.c_str(), 0755));
-  r.laser.deliver(1150000);
-  r.odom(200, 1200000);
+  r.scan_between_odometry(100, 1100000);
   CHECK_FALSE(r.d->write_outputs());
   LONGS_EQUAL(1, r.d->counters().output_failures);
   CHECK(r.log.count(Event::kOutput) == 1U);
@@ -333,9 +337,7 @@ TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {
 TEST(SdpslamdLoop, idle_periods_rewrite_nothing_and_the_set_has_a_manifest) {
   Rig r;
   r.make();
-  r.odom(0, 1000000);
-  r.laser.deliver(1050000);
-  r.odom(100, 1100000);
+  r.scan_between_odometry(0, 1000000);
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(1, r.d->counters().output_writes);
   CHECK_TRUE(file_exists(r.config.output_directory + "/manifest.txt"));
@@ -343,8 +345,7 @@ TEST(SdpslamdLoop, idle_periods_rewrite_nothing_and_the_set_has_a_manifest) {
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(1, r.d->counters().output_writes);
   LONGS_EQUAL(2, r.d->counters().output_writes_unchanged);
-  r.laser.deliver(1150000);
-  r.odom(200, 1200000);
+  r.scan_between_odometry(100, 1100000);
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(2, r.d->counters().output_writes);
   std::vector<io::StampedPose> t;

@@ -38,8 +38,8 @@ void split_path(const std::string& path, std::string* dir, std::string* base) {
   }
 }
 
-// Makes the rename durable. Some file systems refuse fsync on a directory (EINVAL);
-// that is not a failure of the write, the rename has happened.
+}  // namespace
+
 bool fsync_directory(const std::string& dir, std::string* error) {
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0) {
@@ -54,8 +54,6 @@ bool fsync_directory(const std::string& dir, std::string* error) {
   ::close(fd);
   return ok;
 }
-
-}  // namespace
 
 AtomicOutputFile::~AtomicOutputFile() { abandon(); }
 

@@ -2,7 +2,6 @@
 #include "sdpslam/io/output_set.h"
 
 #include <dirent.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -63,21 +62,6 @@ long owner_pid(const std::string& name) {
 bool process_exists(long pid) {
   if (pid == static_cast<long>(::getpid())) return true;
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
-}
-
-bool fsync_dir(const std::string& dir, std::string* error) {
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) {
-    set_error(error, "cannot open directory", dir, errno);
-    return false;
-  }
-  bool ok = true;
-  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
-    set_error(error, "fsync failed on directory", dir, errno);
-    ok = false;
-  }
-  ::close(fd);
-  return ok;
 }
 
 // The plain names in `dir` (no "." or ".."). False (with `error`) iff it cannot be listed.
@@ -267,7 +251,7 @@ bool OutputSet::commit(std::string* error) {
     set_error(error, "cannot remove", manifest_path, errno);
     return false;
   }
-  if (!fsync_dir(dir_, error)) return false;
+  if (!fsync_directory(dir_, error)) return false;
   for (const std::string& n : staged) {
     const std::string from = staging_ + "/" + n;
     const std::string to = dir_ + "/" + n;
@@ -284,7 +268,7 @@ bool OutputSet::commit(std::string* error) {
       return false;
     }
   }
-  if (!fsync_dir(dir_, error)) return false;
+  if (!fsync_directory(dir_, error)) return false;
   return write_file_atomic(manifest_path, manifest, error);
 }
 

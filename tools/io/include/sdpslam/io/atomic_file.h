@@ -45,6 +45,11 @@ class AtomicOutputFile {
   std::string temp_path_;
 };
 
+// Makes renames in `dir` durable (fsync of the directory). Some file systems refuse fsync
+// on a directory (EINVAL, EROFS): not a failure, the renames have happened. False (with
+// `error`) iff it cannot be opened or fsync fails otherwise.
+bool fsync_directory(const std::string& dir, std::string* error);
+
 // Creates `dir` and its parents if missing. False (with `error`) iff that fails.
 bool make_directories(const std::string& dir, std::string* error);
 
