@@ -30,10 +30,17 @@ bool parse_mode(const char* text, SlamMode* mode) {
 struct ParseState {
   DaemonConfig* config;
   std::string file;
-  std::string error;
+  std::string error;   // the first problem found here, "file:line: reason"
+  int error_line = 0;  // its line
   std::FILE* stream = nullptr;
   int line = 0;
   slam::IniDuplicates duplicates;
+
+  void fail(const std::string& why) {
+    if (!error.empty()) return;
+    error = file + ":" + std::to_string(line) + ": " + why;
+    error_line = line;
+  }
 };
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
@@ -50,25 +57,33 @@ bool known_section(const std::string& sec) {
 // unknown section is rejected at its own line even when it holds no key).
 char* read_line(char* str, int num, void* user) {
   auto* st = static_cast<ParseState*>(user);
-  char* r = std::fgets(str, num, st->stream);
+  std::string why;
+  char* r = slam::read_ini_line(st->stream, str, num, &why);
   if (r == nullptr) return r;
   ++st->line;
+  if (!why.empty()) {
+    st->fail(why);
+    return r;
+  }
   const char* p = r;
   while (*p == ' ' || *p == '\t') ++p;
-  if (*p == '[' && st->error.empty()) {
+  if (*p == '[') {
     const char* end = std::strchr(p, ']');
     if (end != nullptr) {
       std::string sec(p + 1, end);
       while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
       while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
-      if (!known_section(sec)) st->error = st->file + ":" + std::to_string(st->line) + ": unknown section [" + sec + "]";
+      if (!known_section(sec)) st->fail("unknown section [" + sec + "]");
     }
   }
-  std::string why;
-  if (!st->duplicates.line(r, &why) && st->error.empty()) {
-    st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
-  }
+  if (!st->duplicates.line(r, &why)) st->fail(why);
   return r;
+}
+
+// The first pass reads the same lines (a refused line is left to the full pass).
+char* read_line_quietly(char* str, int num, void* stream) {
+  std::string why;
+  return slam::read_ini_line(static_cast<std::FILE*>(stream), str, num, &why);
 }
 
 // Value parsers: each returns false with *why set.
@@ -373,7 +388,7 @@ int handler(void* user, const char* section, const char* name, const char* value
   auto* st = static_cast<ParseState*>(user);
   const std::string sec(section);
   std::string why;
-  if (!st->error.empty()) return 0;  // an unknown section header was met
+  if (!st->error.empty()) return 0;  // only the first problem is reported
   if (name == nullptr) {
     if (known_section(sec)) return 1;
     why = "unknown section [" + sec + "]";
@@ -383,7 +398,7 @@ int handler(void* user, const char* section, const char* name, const char* value
     if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
     else if (!slam::is_slam_config_section(sec) && sec != "sdp") why = sec + "." + name + ": " + why;
   }
-  if (st->error.empty()) st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
+  st->fail(why);
   return 0;
 }
 
@@ -405,20 +420,31 @@ int profile_handler(void* user, const char* section, const char* name, const cha
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
   std::FILE* f = slam::open_config_file(path, error);
   if (f == nullptr) return false;
+  const bool ok = load_daemon_config(f, path, config, error);
+  std::fclose(f);
+  return ok;
+}
+
+bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* config, std::string* error) {
   // The [slam] profile (sdp mode) is where the options start: the file's keys go on top of
   // it wherever they appear in the file.
-  (void)ini_parse_file(f, profile_handler, config);
+  (void)ini_parse_stream(read_line_quietly, f, profile_handler, config);
   if (config->mode == SlamMode::kSdp) apply_profile(config->profile, &config->slam.filter, &config->sdp);
   std::rewind(f);
-  ParseState st{config, path, {}, f, 0, {}};
+  ParseState st{config, path, {}, 0, f, 0, {}};
   const int rc = ini_parse_stream(read_line, &st, handler, &st);
-  std::fclose(f);
+  // inih's rc is the first line it could not parse or whose handler failed; a handler
+  // failure has its reason here, so an earlier rc is a malformed line.
+  if (rc > 0 && (st.error.empty() || rc < st.error_line)) {
+    *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
+    return false;
+  }
   if (!st.error.empty()) {
     *error = st.error;
     return false;
   }
-  if (rc != 0) {
-    *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
+  if (rc != 0 || std::ferror(f) != 0) {
+    *error = path + ": read error";
     return false;
   }
   // Checks that involve several keys, once everything is read.

@@ -10,15 +10,14 @@
 #include "sdpslam/drivers/canopen_codec.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/drivers/odrive_codec.h"
+#include "fuzz_text.h"
 
 using namespace sdpslam;
 using namespace sdpslam::drivers;
 
 namespace {
 
-void check(bool ok) {
-  if (!ok) __builtin_trap();
-}
+using sdpslam::test::fuzz::check;
 
 void decode_everything(const hal::CanFrame& f, std::uint8_t node) {
   const canopen::ObjectId obj = canopen::classify(f);

@@ -128,6 +128,39 @@ TEST(SlamConfig, non_numeric_and_negative_integers_are_rejected) {
   STRCMP_CONTAINS(":2:", error.c_str());
 }
 
+// Found by fuzz_slam_config: the unknown key of line 3 was reported, not line 2 before it.
+TEST(SlamConfig, a_malformed_line_before_a_bad_key_is_the_problem_reported) {
+  const std::string path = write_temp("[map]\ntile_capac\nwidth_x = 1\n");
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(path, &c, &error));
+  STRCMP_EQUAL((path + ":2: malformed line (expected [section] or key = value)").c_str(), error.c_str());
+}
+
+// inih parses a line in pieces of 199 bytes: the end of this comment line used to be read
+// as a line of its own and applied.
+TEST(SlamConfig, a_line_longer_than_198_characters_is_refused_at_its_line_not_cut) {
+  const std::string path = write_temp("[filter]\n; " + std::string(197U, 'x') + "particles = 7\n");
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(path, &c, &error));
+  STRCMP_EQUAL((path + ":2: line longer than 198 characters").c_str(), error.c_str());
+  LONGS_EQUAL(DpSlamOptions{}.particle_count, c.filter.particle_count);
+  const std::string longest = write_temp("[filter]\nparticles = 7 ;" + std::string(183U, 'x') + "\n");
+  CHECK_TRUE_TEXT(slam::load_config_ini(longest, &c, &error), error.c_str());
+  LONGS_EQUAL(7, c.filter.particle_count);
+}
+
+// The text after a NUL byte was invisible to the parser: "particles = 7" was applied.
+TEST(SlamConfig, a_nul_byte_in_a_line_is_refused) {
+  const char text[] = "[filter]\nparticles = 7\0 ; 9\n";
+  const std::string path = write_temp(std::string(text, sizeof text - 1U));
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_FALSE(slam::load_config_ini(path, &c, &error));
+  STRCMP_EQUAL((path + ":2: control byte 0x00 in the line (not a text file?)").c_str(), error.c_str());
+}
+
 TEST(SlamConfig, missing_file_is_an_error_naming_it) {
   slam::SlamConfig c;
   std::string error;

@@ -87,7 +87,10 @@ TEST_GROUP(MapRead) {
   std::string dir;
   void setup() override { dir = sdpslam::test::make_temp_dir("map-read"); }
   void teardown() override {
-    for (const char* f : {"/m.pgm", "/m.yaml", "/bad.yaml", "/short.pgm", "/short.yaml"}) ::unlink((dir + f).c_str());
+    for (const char* f : {"/m.pgm", "/m.yaml", "/bad.yaml", "/short.pgm", "/short.yaml", "/over.pgm", "/over.yaml",
+                          "/bare.pgm", "/bare.yaml", "/edge.pgm", "/edge.yaml"}) {
+      ::unlink((dir + f).c_str());
+    }
     ::rmdir(dir.c_str());
   }
   std::string put(const char* name, const std::string& text) {
@@ -137,4 +140,42 @@ TEST(MapRead, names_the_file_and_line_of_what_it_cannot_read) {
   STRCMP_CONTAINS("short.pgm: image data short: 10 of 16 bytes", error.c_str());
   CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(dir + "/none.yaml", &r, nullptr, &error));
   STRCMP_CONTAINS("none.yaml: cannot open", error.c_str());
+}
+
+// Found by fuzz_map_yaml_pgm: a pixel above maxval read as an occupancy outside [0, 1]
+// (-1.9 here, which also posed as "unknown"; above 1 with negate).
+TEST(MapRead, a_pixel_above_maxval_is_refused) {
+  OccupancyImage r;
+  std::string error;
+  put("over.pgm", std::string("P5 2 2 15\n\x00\x0f,\x03", 14U));
+  const std::string yaml = put("over.yaml", "image: over.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(yaml, &r, nullptr, &error));
+  STRCMP_CONTAINS("over.pgm: pixel 2 is 44, above maxval 15", error.c_str());
+  LONGS_EQUAL(0, r.width);
+}
+
+// Found by fuzz_map_yaml_pgm: pixel 14 of maxval 40 is occupancy 0.65, occupied at the
+// default occupied_thresh, but was kept as 0.6499999762F, which MapAgreement (wall iff
+// occupancy >= occupied_thresh) took for no wall.
+TEST(MapRead, a_cell_on_a_threshold_keeps_its_class_in_float) {
+  OccupancyImage r;
+  MapWriteOptions t;
+  std::string error;
+  put("edge.pgm", "P5 1 1 40\n\x0e");
+  const std::string yaml = put("edge.yaml", "image: edge.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  CHECK_TRUE_TEXT(sdpslam::io::read_map_pgm_yaml(yaml, &r, &t, &error), error.c_str());
+  LONGS_EQUAL(1, r.occupancy.size());
+  CHECK_TRUE(r.occupancy[0] >= t.occupied_thresh);
+  DOUBLES_EQUAL(0.65, r.occupancy[0], 1e-7);
+}
+
+// A header ending the file without the whitespace after maxval: the count of bytes
+// present was 2^64 - 1.
+TEST(MapRead, a_header_without_pixels_reports_zero_bytes_present) {
+  OccupancyImage r;
+  std::string error;
+  put("bare.pgm", "P5 2 2 255");
+  const std::string yaml = put("bare.yaml", "image: bare.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(yaml, &r, nullptr, &error));
+  STRCMP_CONTAINS("bare.pgm: image data short: 0 of 4 bytes", error.c_str());
 }

@@ -222,6 +222,28 @@ TEST(TrajectoryFile, reader_refuses_bad_stamp_and_non_finite_values) {
   STRCMP_CONTAINS(":1:", error.c_str());
 }
 
+// Found by fuzz_trajectory: a sine of -0 (qw < 0) made atan2 give -pi, outside (-pi, pi].
+TEST(TrajectoryFile, tum_heading_of_a_negative_zero_sine_is_pi) {
+  std::istringstream in("-6 2930 8 00 -0 8 00 -1\n");
+  std::vector<StampedPose> back;
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::read_trajectory(in, "t.txt", &back, &error), error.c_str());
+  LONGS_EQUAL(1, back.size());
+  DOUBLES_EQUAL(3.14159265358979323846, back[0].pose.heading_rad, 0.0);
+}
+
+// Squares of huge components overflowed to inf - inf = NaN; tiny ones vanished into a
+// "zero quaternion".
+TEST(TrajectoryFile, tum_quaternion_of_huge_or_tiny_components_gives_its_yaw) {
+  std::istringstream in("1 0 0 0 0 0 1e200 1e200\n2 0 0 0 0 0 1e-200 1e-200\n");
+  std::vector<StampedPose> back;
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::read_trajectory(in, "t.txt", &back, &error), error.c_str());
+  LONGS_EQUAL(2, back.size());
+  DOUBLES_EQUAL(3.14159265358979323846 / 2.0, back[0].pose.heading_rad, 1e-12);
+  DOUBLES_EQUAL(3.14159265358979323846 / 2.0, back[1].pose.heading_rad, 1e-12);
+}
+
 TEST(TrajectoryFile, reader_of_missing_file_names_it) {
   std::vector<StampedPose> back;
   std::string error;

@@ -168,6 +168,31 @@ TEST(ReplayFrames, odrive_frames_carry_turns_and_turns_per_second) {
   DOUBLES_EQUAL(-5.0, e.vel_turns_s, 1e-5);
 }
 
+// Found by fuzz_tinyslam_ticks: raw counters INT64_MAX and INT64_MIN one sample apart
+// overflowed their int64 difference (undefined behaviour; a wrapped +1 tick). Stamps near
+// 5e18 lie 1024 µs apart in double: their step must be taken exactly.
+TEST(ReplayFrames, odrive_velocity_of_counters_and_stamps_far_apart_is_finite_and_signed) {
+  std::vector<TickSample> track = {{1, 9223372036854775807LL, -9223372036854775807LL - 1},
+                                   {2, -9223372036854775807LL - 1, 9223372036854775807LL},
+                                   {4963744073704775807LL, 0, 0},
+                                   {4963744073704775824LL, 17, -17}};
+  EncoderFrameOptions o;
+  o.protocol = drivers::EncoderProtocol::kODrive;
+  std::vector<drivers::CandumpRecord> frames;
+  std::string error;
+  CHECK_TRUE(tick_track_to_frames(track, o, &frames, &error));
+  LONGS_EQUAL(8, frames.size());
+  drivers::odrive::EncoderEstimates e;
+  CHECK_TRUE(drivers::odrive::decode_encoder_estimates(frames[2].frame, o.left_node, e) == drivers::CanDecodeError::kOk);
+  DOUBLES_EQUAL(-18446744073709551615.0 / 2000.0 / 1e-6, e.vel_turns_s, 1e16);
+  CHECK_TRUE(drivers::odrive::decode_encoder_estimates(frames[3].frame, o.right_node, e) == drivers::CanDecodeError::kOk);
+  DOUBLES_EQUAL(18446744073709551615.0 / 2000.0 / 1e-6, e.vel_turns_s, 1e16);
+  CHECK_TRUE(drivers::odrive::decode_encoder_estimates(frames[6].frame, o.left_node, e) == drivers::CanDecodeError::kOk);
+  DOUBLES_EQUAL(17.0 / 2000.0 / 17e-6, e.vel_turns_s, 1e-3);
+  CHECK_TRUE(drivers::odrive::decode_encoder_estimates(frames[7].frame, o.right_node, e) == drivers::CanDecodeError::kOk);
+  DOUBLES_EQUAL(-17.0 / 2000.0 / 17e-6, e.vel_turns_s, 1e-3);
+}
+
 TEST(ReplayFrames, out_of_range_or_equal_node_ids_are_refused) {
   std::vector<TickSample> track = {{0, 0, 0}};
   EncoderFrameOptions o;
@@ -202,6 +227,24 @@ TEST(ReplayFrames, tinyslam_reader_keeps_good_lines_and_names_bad_ones) {
   LONGS_EQUAL(30, t.samples[1].right_ticks);
   CHECK_EQUAL(4294967296LL, t.samples[2].left_ticks);
   LONGS_EQUAL(-5, t.samples[2].right_ticks);
+}
+
+// Found by fuzz_tinyslam_ticks: the parser stops at a NUL byte, so a line holding one was
+// read as what came before it (or, starting with one, skipped as blank, unreported).
+TEST(ReplayFrames, tinyslam_reader_lists_a_line_holding_a_nul_byte_as_an_error) {
+  const char text[] = "100 7 10 20 0 0\n200 7 11 21 0 3\x13\0\0p`\n\0 7 12 22\n300 7 13 23\n";
+  std::string data(text, sizeof text - 1U);
+  std::FILE* f = ::fmemopen(&data[0], data.size(), "r");
+  CHECK(f != nullptr);
+  TinySlamTicks t;
+  std::string error;
+  CHECK_TRUE_TEXT(read_tinyslam_ticks(f, "t.dat", &t, &error), error.c_str());
+  std::fclose(f);
+  LONGS_EQUAL(2, t.samples.size());
+  LONGS_EQUAL(300, t.samples[1].stamp_us);
+  LONGS_EQUAL(2, t.errors.size());
+  STRCMP_EQUAL("t.dat:2: NUL byte in the line (not a text file?)", t.errors[0].c_str());
+  STRCMP_EQUAL("t.dat:3: NUL byte in the line (not a text file?)", t.errors[1].c_str());
 }
 
 TEST(ReplayFrames, tinyslam_reader_fails_on_a_missing_file) {

@@ -90,6 +90,24 @@ TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line
   CHECK_TRUE_TEXT(error.find("topology") != std::string::npos, error.c_str());
 }
 
+// Found with fuzz_slam_config's check that a refusal is the file's first problem: the
+// reason of a later bad line was reported under the line number of the first one.
+TEST(SdpConfig, a_refusal_names_the_first_bad_line_with_its_own_reason) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_config_first");
+  const std::string path = dir + "/c.ini";
+  std::ofstream(path) << "[sdp]\ntop_particles = x\nmax_levels = 1\n";
+  SdpOptions o;
+  std::string error;
+  CHECK_FALSE(slam::load_sdp_ini(path, &o, &error));
+  STRCMP_EQUAL((path + ":2: [sdp] top_particles: malformed value 'x'").c_str(), error.c_str());
+  std::ofstream(path) << "[sdp]\nbroken line\nno_such_key = 1\n";
+  CHECK_FALSE(slam::load_sdp_ini(path, &o, &error));
+  STRCMP_EQUAL((path + ":2: malformed line").c_str(), error.c_str());
+  std::ofstream(path) << "[sdp]\n; " + std::string(197U, 'x') + "max_levels = 1\n";
+  CHECK_FALSE(slam::load_sdp_ini(path, &o, &error));
+  STRCMP_EQUAL((path + ":2: line longer than 198 characters").c_str(), error.c_str());
+}
+
 TEST(SdpConfig, accurate_profile_turns_on_scan_matching_loop_closure_and_search) {
   DpSlamOptions b;
   SdpOptions o;

@@ -251,6 +251,18 @@ TEST(SdpslamdConfig, a_state_the_core_cannot_address_or_above_the_budget_is_refu
   expect_rejected("[daemon]\nmemory_budget_mib = 12.5\n", 2, "not an integer");
 }
 
+// A binary file given as the config: the first line with a control byte is refused as
+// such, and the message carries none of the file's bytes (a terminal escape sequence
+// would otherwise reach the user's terminal).
+TEST(SdpslamdConfig, a_binary_file_is_refused_without_echoing_its_bytes) {
+  const std::string text = "[can]\ninterface = can0\x1b]0;owned\x07\n\x7f" "ELF\x02\x01\n";
+  expect_rejected(text, 2, "control byte 0x1B in the line (not a text file?)");
+  DaemonConfig c;
+  std::string error;
+  CHECK_FALSE(load_daemon_config(write_ini(text), &c, &error));
+  for (const char ch : error) CHECK_TEXT(static_cast<unsigned char>(ch) >= 0x20 && ch != 0x7F, error.c_str());
+}
+
 // The unit's MemoryMax= sits above the default budget of the state, with room for the
 // rest of the process.
 TEST(SdpslamdConfig, the_units_memory_ceiling_is_above_the_default_state_budget) {

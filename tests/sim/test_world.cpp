@@ -137,6 +137,22 @@ TEST(SimWorld, route_parser_refuses_a_single_waypoint) {
   STRCMP_EQUAL("route.txt: a route needs at least 2 waypoints", error.c_str());
 }
 
+// Legs of 2e308 m summed to an infinite route length, which `sdpslam simulate` converts
+// to an integer (undefined behaviour); walls that far apart gave the ray caster an
+// infinite extent.
+TEST(SimWorld, coordinates_beyond_1000_km_are_refused) {
+  Route r;
+  std::string error;
+  CHECK_FALSE(parse_route("-1e308 0\n1e308 0\n", "route.txt", &r, &error));
+  STRCMP_EQUAL("route.txt:1: '-1e308' lies beyond the largest coordinate, 1e6 m", error.c_str());
+  CHECK_TRUE_TEXT(parse_route("-1e6 0\n1e6 0\n-1e6 0\n", "route.txt", &r, &error), error.c_str());
+  CHECK_TRUE(std::isfinite(route_length_m(r)));
+  World w;
+  CHECK_FALSE(parse_world("0 0 1 0\n1e300 0 1e300 1\n", "walls.txt", &w, &error));
+  STRCMP_EQUAL("walls.txt:2: '1e300' lies beyond the largest coordinate, 1e6 m", error.c_str());
+  LONGS_EQUAL(1, w.segments.size());
+}
+
 TEST(SimWorld, distance_to_nearest_wall_measures_to_the_segment_not_the_line) {
   World w;
   w.segments.push_back(Segment{{0.0, 0.0}, {1.0, 0.0}});

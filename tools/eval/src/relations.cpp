@@ -32,6 +32,11 @@ bool read_relations(const std::string& path, std::vector<Relation>* relations, s
     if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
     return false;
   }
+  return read_relations(in, path, relations, error);
+}
+
+bool read_relations(std::istream& in, const std::string& path, std::vector<Relation>* relations, std::string* error) {
+  relations->clear();
   std::string line;
   std::int64_t line_no = 0;
   auto fail = [&](const std::string& reason) {

@@ -365,10 +365,7 @@ bool pgm_token(const std::string& data, std::size_t* pos, std::string* token) {
 
 }  // namespace
 
-bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
-                       std::string* error) {
-  std::ifstream yaml(yaml_path);
-  if (!yaml) return map_read_error(error, yaml_path, "cannot open");
+bool parse_map_yaml(std::istream& yaml, const std::string& yaml_path, MapYaml* out, std::string* error) {
   std::string image;
   double resolution = 0.0;
   double origin_x = 0.0;
@@ -417,14 +414,17 @@ bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWri
   if (!(t.free_thresh >= 0.0 && t.free_thresh < t.occupied_thresh && t.occupied_thresh <= 1.0)) {
     return map_read_error(error, yaml_path, "thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1");
   }
-  std::string pgm_path = image;
-  const std::size_t slash = yaml_path.find_last_of('/');
-  if (image[0] != '/' && slash != std::string::npos) pgm_path = yaml_path.substr(0, slash + 1U) + image;
-  std::ifstream in(pgm_path, std::ios::binary);
-  if (!in) return map_read_error(error, pgm_path, "cannot open (named by " + yaml_path + ")");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string data = ss.str();
+  out->image = image;
+  out->resolution_m = resolution;
+  out->origin_x_m = origin_x;
+  out->origin_y_m = origin_y;
+  out->thresholds = t;
+  return true;
+}
+
+bool decode_map_pgm(const std::string& data, const std::string& pgm_path, const MapYaml& yaml, OccupancyImage* map,
+                    std::string* error) {
+  const MapWriteOptions& t = yaml.thresholds;
   std::size_t pos = 0U;
   std::string magic, ws, hs, ms;
   if (!pgm_token(data, &pos, &magic) || magic != "P5") return map_read_error(error, pgm_path, "not a binary PGM (P5)");
@@ -436,30 +436,61 @@ bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWri
   const long maxval = std::strtol(ms.c_str(), nullptr, 10);
   if (w <= 0 || h <= 0 || w > 100000 || h > 100000) return map_read_error(error, pgm_path, "bad size " + ws + " x " + hs);
   if (maxval <= 0 || maxval > 255) return map_read_error(error, pgm_path, "maxval must be 1..255");
-  ++pos;  // the single whitespace after maxval
+  ++pos;  // the single whitespace after maxval (absent at the end of a file without pixels)
   const std::size_t cells = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  if (data.size() < pos + cells) {
+  const std::size_t have = data.size() > pos ? data.size() - pos : 0U;
+  if (have < cells) {
     return map_read_error(error, pgm_path,
-                          "image data short: " + std::to_string(data.size() - pos) + " of " + std::to_string(cells) + " bytes");
+                          "image data short: " + std::to_string(have) + " of " + std::to_string(cells) + " bytes");
   }
   OccupancyImage m;
   m.width = static_cast<std::uint32_t>(w);
   m.height = static_cast<std::uint32_t>(h);
-  m.resolution_m = resolution;
-  m.origin_x_m = origin_x;
-  m.origin_y_m = origin_y;
+  m.resolution_m = yaml.resolution_m;
+  m.origin_x_m = yaml.origin_x_m;
+  m.origin_y_m = yaml.origin_y_m;
   m.occupancy.assign(cells, -1.0F);
   for (std::uint32_t r = 0; r < m.height; ++r) {
     const std::size_t src = pos + static_cast<std::size_t>(m.height - 1U - r) * m.width;
     for (std::uint32_t c = 0; c < m.width; ++c) {
-      const double v = static_cast<unsigned char>(data[src + c]) / static_cast<double>(maxval);
+      const auto pixel = static_cast<unsigned char>(data[src + c]);
+      if (pixel > maxval) {
+        // Netpbm: "each gray value is a number from 0 through maxval".
+        return map_read_error(error, pgm_path,
+                              "pixel " + std::to_string(src + c - pos) + " is " + std::to_string(pixel) +
+                                  ", above maxval " + std::to_string(maxval));
+      }
+      const double v = pixel / static_cast<double>(maxval);
       const double p = t.negate ? v : 1.0 - v;
       if (p > t.free_thresh && p < t.occupied_thresh) continue;  // unknown
-      m.occupancy[static_cast<std::size_t>(r) * m.width + c] = static_cast<float>(p);
+      // The class is decided in double; the float kept must fall in the same class for a
+      // reader that compares it with the thresholds (eval::MapAgreement). At a threshold
+      // rounding may cross it (0.65 becomes 0.6499999762F): the next float inward is kept.
+      float kept = static_cast<float>(p);
+      if (p >= t.occupied_thresh && kept < t.occupied_thresh) kept = std::nextafter(kept, 2.0F);
+      if (p <= t.free_thresh && kept > t.free_thresh) kept = std::nextafter(kept, -1.0F);
+      m.occupancy[static_cast<std::size_t>(r) * m.width + c] = kept;
     }
   }
   *map = std::move(m);
-  if (thresholds != nullptr) *thresholds = t;
+  return true;
+}
+
+bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
+                       std::string* error) {
+  std::ifstream yaml(yaml_path);
+  if (!yaml) return map_read_error(error, yaml_path, "cannot open");
+  MapYaml meta;
+  if (!parse_map_yaml(yaml, yaml_path, &meta, error)) return false;
+  std::string pgm_path = meta.image;
+  const std::size_t slash = yaml_path.find_last_of('/');
+  if (meta.image[0] != '/' && slash != std::string::npos) pgm_path = yaml_path.substr(0, slash + 1U) + meta.image;
+  std::ifstream in(pgm_path, std::ios::binary);
+  if (!in) return map_read_error(error, pgm_path, "cannot open (named by " + yaml_path + ")");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (!decode_map_pgm(ss.str(), pgm_path, meta, map, error)) return false;
+  if (thresholds != nullptr) *thresholds = meta.thresholds;
   return true;
 }
 

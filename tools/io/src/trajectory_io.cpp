@@ -8,6 +8,7 @@
 //  - TUM quaternion components: "%.9f".
 #include "sdpslam/io/trajectory_io.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cmath>
@@ -154,6 +155,10 @@ bool read_trajectory(const std::string& path, std::vector<StampedPose>* poses, s
     if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
     return false;
   }
+  return read_trajectory(in, path, poses, error);
+}
+
+bool read_trajectory(std::istream& in, const std::string& path, std::vector<StampedPose>* poses, std::string* error) {
   std::vector<StampedPose> result;
   std::string line;
   std::int64_t line_no = 0;
@@ -192,14 +197,25 @@ bool read_trajectory(const std::string& path, std::vector<StampedPose>* poses, s
     if (tokens.size() == 4) {
       sp.pose.heading_rad = normalize_angle_rad(v[2]);
     } else {
-      const double qx = v[3];
-      const double qy = v[4];
-      const double qz = v[5];
-      const double qw = v[6];
+      double qx = v[3];
+      double qy = v[4];
+      double qz = v[5];
+      double qw = v[6];
+      const double scale = std::max({std::fabs(qx), std::fabs(qy), std::fabs(qz), std::fabs(qw)});
+      if (!(scale > 0.0)) return fail("zero quaternion");
+      // The yaw does not change with the quaternion's scale: huge or tiny components are
+      // brought near 1 first, so that their squares neither overflow nor vanish.
+      if (scale > 1e100 || scale < 1e-100) {
+        qx /= scale;
+        qy /= scale;
+        qz /= scale;
+        qw /= scale;
+      }
       const double norm2 = qx * qx + qy * qy + qz * qz + qw * qw;
-      if (!(norm2 > 0.0)) return fail("zero quaternion");
-      // Yaw of a general quaternion (z-y-x convention); exact for yaw-only ones.
-      sp.pose.heading_rad = std::atan2(2.0 * (qw * qz + qx * qy), norm2 - 2.0 * (qy * qy + qz * qz));
+      // Yaw of a general quaternion (z-y-x convention); exact for yaw-only ones. atan2
+      // gives -pi for a negative zero sine: wrapped to (-pi, pi] like the other format.
+      sp.pose.heading_rad =
+          normalize_angle_rad(std::atan2(2.0 * (qw * qz + qx * qy), norm2 - 2.0 * (qy * qy + qz * qz)));
     }
     result.push_back(sp);
   }

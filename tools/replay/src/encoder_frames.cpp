@@ -111,9 +111,15 @@ bool tick_track_to_frames(const std::vector<TickSample>& track, const EncoderFra
       el.pos_turns = static_cast<float>(static_cast<double>(s.left_ticks) / tpr);
       er.pos_turns = static_cast<float>(static_cast<double>(s.right_ticks) / tpr);
       if (i > 0 && s.stamp_us > track[i - 1].stamp_us) {
-        const double dt_s = static_cast<double>(s.stamp_us - track[i - 1].stamp_us) * 1e-6;
-        el.vel_turns_s = static_cast<float>(static_cast<double>(s.left_ticks - track[i - 1].left_ticks) / tpr / dt_s);
-        er.vel_turns_s = static_cast<float>(static_cast<double>(s.right_ticks - track[i - 1].right_ticks) / tpr / dt_s);
+        // Raw counters and stamps may lie so far apart that their int64 difference
+        // overflows. The stamp step is positive here, exact in uint64; the counter steps
+        // are taken in double (exact below 2^53).
+        auto diff = [](std::int64_t a, std::int64_t b) { return static_cast<double>(a) - static_cast<double>(b); };
+        const std::uint64_t step_us =
+            static_cast<std::uint64_t>(s.stamp_us) - static_cast<std::uint64_t>(track[i - 1].stamp_us);
+        const double dt_s = static_cast<double>(step_us) * 1e-6;
+        el.vel_turns_s = static_cast<float>(diff(s.left_ticks, track[i - 1].left_ticks) / tpr / dt_s);
+        er.vel_turns_s = static_cast<float>(diff(s.right_ticks, track[i - 1].right_ticks) / tpr / dt_s);
       }
       hal::CanFrame l, r;
       drivers::odrive::make_encoder_estimates(o.left_node, el, l);

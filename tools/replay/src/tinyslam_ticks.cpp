@@ -34,6 +34,13 @@ bool read_tinyslam_ticks(const std::string& path, TinySlamTicks* out, std::strin
     *error = path + ": cannot open: " + std::strerror(errno);
     return false;
   }
+  const bool ok = read_tinyslam_ticks(f, path, out, error);
+  std::fclose(f);
+  return ok;
+}
+
+bool read_tinyslam_ticks(std::FILE* f, const std::string& path, TinySlamTicks* out, std::string* error) {
+  *out = TinySlamTicks{};
   // Lines carry ~700 numbers; only the first three are needed, the rest is skipped.
   std::string line;
   long long line_no = 0;
@@ -45,9 +52,14 @@ bool read_tinyslam_ticks(const std::string& path, TinySlamTicks* out, std::strin
     ++line_no;
     const char* p = line.c_str();
     while (*p == ' ' || *p == '\t') ++p;
+    const std::string where = path + ":" + std::to_string(line_no) + ": ";
+    // The parser sees the text up to a NUL byte only: such a line is not what it looks like.
+    if (line.find('\0') != std::string::npos) {
+      out->errors.push_back(where + "NUL byte in the line (not a text file?)");
+      continue;
+    }
     if (*p == '\0' || *p == '\r' || *p == '#') continue;
     long long stamp = 0, unused = 0, left = 0, right = 0;
-    const std::string where = path + ":" + std::to_string(line_no) + ": ";
     if (!next_int(&p, &stamp) || !next_int(&p, &unused) || !next_int(&p, &left) || !next_int(&p, &right)) {
       out->errors.push_back(where + "fields 1, 3, 4 (stamp us, left ticks, right ticks) are not integers");
       continue;
@@ -62,9 +74,7 @@ bool read_tinyslam_ticks(const std::string& path, TinySlamTicks* out, std::strin
     }
     out->samples.push_back(TickSample{stamp, left, right});
   }
-  const bool read_error = std::ferror(f) != 0;
-  std::fclose(f);
-  if (read_error) {
+  if (std::ferror(f) != 0) {
     *error = path + ": read error";
     return false;
   }

@@ -16,7 +16,7 @@ namespace {
 using detail::WallBuilder;
 
 // Strips a trailing comment and splits into numbers. Returns false with `reason` iff a
-// token is not a finite number.
+// token is not a finite number within ±kMaxCoordinate_m.
 bool split_numbers(const std::string& line, std::vector<double>* out, std::string* reason) {
   out->clear();
   const std::string body = line.substr(0, line.find('#'));
@@ -30,6 +30,10 @@ bool split_numbers(const std::string& line, std::vector<double>* out, std::strin
     const auto res = std::from_chars(first, last, v);
     if (res.ec != std::errc() || res.ptr != last || !std::isfinite(v)) {
       *reason = "'" + token + "' is not a finite number";
+      return false;
+    }
+    if (std::fabs(v) > kMaxCoordinate_m) {
+      *reason = "'" + token + "' lies beyond the largest coordinate, 1e6 m";
       return false;
     }
     out->push_back(v);

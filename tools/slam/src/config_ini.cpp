@@ -17,22 +17,28 @@ namespace {
 struct ParseState {
   SlamConfig* config;
   std::string file;
-  std::string error;
+  std::string error;      // the first problem found here, "file:line: reason"
+  int error_line = 0;     // its line
   std::FILE* stream = nullptr;
   int line = 0;  // lines handed to inih so far = the line being handled
   IniDuplicates duplicates;
+
+  void fail(const std::string& why) {
+    if (!error.empty()) return;
+    error = file + ":" + std::to_string(line) + ": " + why;
+    error_line = line;
+  }
 };
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
 char* read_line(char* str, int num, void* user) {
   auto* st = static_cast<ParseState*>(user);
-  char* r = std::fgets(str, num, st->stream);
+  std::string why;
+  char* r = read_ini_line(st->stream, str, num, &why);
   if (r == nullptr) return r;
   ++st->line;
-  std::string why;
-  if (!st->duplicates.line(r, &why) && st->error.empty()) {
-    st->error = st->file + ":" + std::to_string(st->line) + ": " + why;
-  }
+  if (why.empty()) (void)st->duplicates.line(r, &why);
+  if (!why.empty()) st->fail(why);
   return r;
 }
 
@@ -150,12 +156,11 @@ bool set_option(DpSlamOptions& o, const std::string& section, const std::string&
 
 int handler(void* user, const char* section, const char* name, const char* value) {
   auto* st = static_cast<ParseState*>(user);
-  const int lineno = st->line;
   if (name == nullptr) return 1;  // section header alone
   if (!st->error.empty()) return 0;
   std::string dup;
   if (!st->duplicates.key(section, name, &dup)) {
-    st->error = st->file + ":" + std::to_string(lineno) + ": " + dup;
+    st->fail(dup);
     return 0;
   }
   // [sdp] belongs to the SDP-SLAM top level; its keys are read by load_sdp_ini (run_sdp.h).
@@ -164,11 +169,41 @@ int handler(void* user, const char* section, const char* name, const char* value
   const ConfigKeyResult r = apply_config_key(st->config, section, name, value, &why);
   if (r == ConfigKeyResult::kApplied) return 1;
   if (r == ConfigKeyResult::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + section + "]";
-  if (st->error.empty()) st->error = st->file + ":" + std::to_string(lineno) + ": " + why;
+  st->fail(why);
   return 0;
 }
 
 }  // namespace
+
+char* read_ini_line(std::FILE* stream, char* str, int num, std::string* why) {
+  const auto room = static_cast<std::size_t>(num) - 1U;  // bytes before the terminating NUL
+  std::size_t len = 0;
+  bool too_long = false;
+  int control = -1;  // the first control byte other than tab, CR and LF
+  int c = EOF;
+  while ((c = std::getc(stream)) != EOF) {
+    if (len < room) {
+      str[len++] = static_cast<char>(c);
+    } else {
+      too_long = true;
+    }
+    if (control < 0 && (c < 0x20 || c == 0x7F) && c != '\t' && c != '\r' && c != '\n') control = c;
+    if (c == '\n') break;
+  }
+  if (len == 0 && !too_long && c == EOF) return nullptr;
+  str[len] = '\0';
+  // A control byte means a binary file (or a terminal escape sequence): the line is
+  // refused whole, so no error message echoes its bytes to the user's terminal.
+  if (too_long || control >= 0) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(control));
+    *why = too_long ? "line longer than " + std::to_string(num - 2) + " characters"
+                    : std::string("control byte ") + hex + " in the line (not a text file?)";
+    str[0] = '\n';
+    str[1] = '\0';
+  }
+  return str;
+}
 
 bool IniDuplicates::line(const char* line, std::string* why) {
   const char* p = line;
@@ -260,18 +295,27 @@ bool load_config_ini(const std::string& path, SlamConfig* config, std::string* e
     if (error != nullptr) *error = why;
     return false;
   }
-  ParseState st{config, path, {}, f, 0, {}};
-  const int rc = ini_parse_stream(read_line, &st, handler, &st);
+  const bool ok = load_config_ini(f, path, config, error);
   std::fclose(f);
-  if (!st.error.empty()) {
-    if (error != nullptr) *error = st.error;
-    return false;
+  return ok;
+}
+
+bool load_config_ini(std::FILE* stream, const std::string& name, SlamConfig* config, std::string* error) {
+  ParseState st{config, name, {}, 0, stream, 0, {}};
+  const int rc = ini_parse_stream(read_line, &st, handler, &st);
+  // inih's rc is the first line it could not parse or whose handler failed; a handler
+  // failure has its reason here, so an earlier rc is a malformed line.
+  std::string why;
+  if (rc > 0 && (st.error.empty() || rc < st.error_line)) {
+    why = name + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
+  } else if (!st.error.empty()) {
+    why = st.error;
+  } else if (rc != 0 || std::ferror(stream) != 0) {
+    why = name + ": read error";
   }
-  if (rc != 0) {
-    if (error != nullptr) *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
-    return false;
-  }
-  return true;
+  if (why.empty()) return true;
+  if (error != nullptr) *error = why;
+  return false;
 }
 
 }  // namespace sdpslam::slam

@@ -50,18 +50,36 @@ bool parse_u32(const char* v, std::uint32_t* out) {
 
 struct IniState {
   SdpOptions* options;
+  std::FILE* stream;
+  int line = 0;        // lines handed to inih so far = the line being handled
+  int error_line = 0;  // the first line refused here, with its reason
   std::string why;
+
+  void fail(const std::string& reason) {
+    if (error_line != 0) return;
+    error_line = line;
+    why = reason;
+  }
 };
+
+char* sdp_read_line(char* str, int num, void* user) {
+  auto* st = static_cast<IniState*>(user);
+  std::string why;
+  char* r = read_ini_line(st->stream, str, num, &why);
+  if (r == nullptr) return r;
+  ++st->line;
+  if (!why.empty()) st->fail(why);
+  return r;
+}
 
 int sdp_handler(void* user, const char* section, const char* name, const char* value) {
   auto* st = static_cast<IniState*>(user);
   if (std::strcmp(section, "sdp") != 0) return 1;
-  const SdpKeyResult r = apply_sdp_key(st->options, name, value, &st->why);
-  if (r == SdpKeyResult::kUnknown) {
-    st->why = std::string("unknown key [sdp] ") + name;
-    return 0;
-  }
-  return r == SdpKeyResult::kApplied ? 1 : 0;
+  std::string why;
+  const SdpKeyResult r = apply_sdp_key(st->options, name, value, &why);
+  if (r == SdpKeyResult::kApplied) return 1;
+  st->fail(r == SdpKeyResult::kUnknown ? std::string("unknown key [sdp] ") + name : why);
+  return 0;
 }
 
 // ---- outputs ------------------------------------------------------------------------
@@ -248,14 +266,26 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
 bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error) {
   std::FILE* f = open_config_file(path, error);
   if (f == nullptr) return false;
-  IniState st{options, {}};
-  const int rc = ini_parse_file(f, sdp_handler, &st);
+  const bool ok = load_sdp_ini(f, path, options, error);
   std::fclose(f);
-  if (rc != 0) {
-    *error = path + ":" + std::to_string(rc) + ": " + (st.why.empty() ? std::string("malformed line") : st.why);
-    return false;
+  return ok;
+}
+
+bool load_sdp_ini(std::FILE* stream, const std::string& name, SdpOptions* options, std::string* error) {
+  IniState st{options, stream, 0, 0, {}};
+  const int rc = ini_parse_stream(sdp_read_line, &st, sdp_handler, &st);
+  // inih's rc is the first line it could not parse or whose handler failed; a handler
+  // failure has its reason here, so an earlier rc is a malformed line.
+  if (rc > 0 && (st.error_line == 0 || rc < st.error_line)) {
+    *error = name + ":" + std::to_string(rc) + ": malformed line";
+  } else if (st.error_line != 0) {
+    *error = name + ":" + std::to_string(st.error_line) + ": " + st.why;
+  } else if (rc != 0 || std::ferror(stream) != 0) {
+    *error = name + ": read error";
+  } else {
+    return true;
   }
-  return true;
+  return false;
 }
 
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,

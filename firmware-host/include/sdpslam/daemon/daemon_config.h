@@ -19,6 +19,7 @@
 // Unknown sections and keys, malformed and out-of-range values are rejected as
 // "file:line: reason"; keys left out keep their defaults.
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "sdpslam/core/pose2.h"
@@ -98,11 +99,15 @@ struct DaemonConfig {
 };
 
 // Applies the keys of `path` on top of *config. False iff the file cannot be read, a line
-// is malformed, a section or key is unknown, or a value is malformed or out of range;
-// `error` is then "file:line: reason" (the first problem; *config is then unspecified).
+// is malformed (slam::read_ini_line's refusals included), a section or key is unknown, or
+// a value is malformed or out of range; `error` is then "file:line: reason" (the first
+// problem; *config is then unspecified).
 // Checks that involve several keys (SICK variant, drive geometry, filter options, and in
 // sdp mode the [sdp] options and the bottom options SDP-SLAM derives from [filter] etc.)
 // run once the file is read and name the file and the section.
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error);
+// The same from an open stream, which is read twice (the [slam] profile first) and so must
+// be seekable; it is not closed. `name` stands for the file in messages.
+bool load_daemon_config(std::FILE* stream, const std::string& name, DaemonConfig* config, std::string* error);
 
 }  // namespace sdpslam::daemon

@@ -9,6 +9,7 @@
 // reported as mean ± sample standard deviation of the absolute and of the squared errors.
 // p1, p2 are the estimated poses of the laser scans carrying stamps t1, t2.
 #include <cstdint>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ struct Relation {
 // skipped. False iff the file cannot be read or a line is malformed; `error` then says
 // "file:line: reason" and `*relations` holds the relations read before that line.
 bool read_relations(const std::string& path, std::vector<Relation>* relations, std::string* error);
+// The same from a stream read to its end; `name` stands for the file in messages.
+bool read_relations(std::istream& in, const std::string& name, std::vector<Relation>* relations, std::string* error);
 
 // Completes a possibly sparse estimate into one pose per laser scan, as the benchmark
 // prescribes ("fill missing scans with the last estimate composed with odometry"):

@@ -4,6 +4,7 @@
 //    integer stamp, x y in metres, theta in radians.
 //  - TUM: "t x y z qx qy qz qw" with z = 0 and a yaw-only quaternion.
 #include <cstdint>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -29,5 +30,7 @@ bool write_trajectory_tum(const std::string& path, const std::vector<StampedPose
 // with '#' are comments. False iff the file cannot be read or a line is malformed
 // (`error` says file:line: reason).
 bool read_trajectory(const std::string& path, std::vector<StampedPose>* poses, std::string* error);
+// The same from a stream read to its end; `name` stands for the file in messages.
+bool read_trajectory(std::istream& in, const std::string& name, std::vector<StampedPose>* poses, std::string* error);
 
 }  // namespace sdpslam::io

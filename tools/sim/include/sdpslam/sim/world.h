@@ -107,10 +107,15 @@ double route_start_heading_rad(const Route& route);
 double route_length_m(const Route& route, std::size_t first, std::size_t last);
 double route_length_m(const Route& route);
 
+// World and route coordinates lie within ±kMaxCoordinate_m (1000 km): within it every
+// length, extent and sum of legs the simulator forms is a finite number; the text of a
+// number beyond it (1e308, or a typo's 1e30) is refused.
+inline constexpr double kMaxCoordinate_m = 1e6;
+
 // Parses world text. `source_name` prefixes errors ("world.txt:12: expected 4 numbers,
-// got 3"). Returns false iff a line is malformed (not exactly four finite numbers), a
-// segment has zero length, or there is no segment at all; `world` then holds the
-// segments of the lines before the first error.
+// got 3"). Returns false iff a line is malformed (not exactly four finite numbers within
+// ±kMaxCoordinate_m), a segment has zero length, or there is no segment at all; `world`
+// then holds the segments of the lines before the first error.
 bool parse_world(const std::string& text, const std::string& source_name, World* world, std::string* error);
 // Reads and parses a world file; false (with `error` naming the path) iff unreadable or
 // malformed.
@@ -119,8 +124,8 @@ bool load_world_file(const std::string& path, World* world, std::string* error);
 // round-trip formatting).
 std::string format_world(const World& world);
 
-// Route text: like the world, two numbers per line, at least two waypoints, consecutive
-// waypoints distinct.
+// Route text: like the world, two numbers per line (within ±kMaxCoordinate_m), at least
+// two waypoints, consecutive waypoints distinct.
 bool parse_route(const std::string& text, const std::string& source_name, Route* route, std::string* error);
 bool load_route_file(const std::string& path, Route* route, std::string* error);
 

@@ -18,18 +18,34 @@ struct SlamConfig {
 };
 
 // Applies the keys of `path` on top of *config (keys not in the file keep their value).
-// False iff the file cannot be read, a line is malformed, a section/key is unknown, a
-// value is not a finite number of the right kind, or a value makes the options invalid;
-// `error` is then "file:line: reason"; also iff a section or a key is given twice
+// False iff the file cannot be read, a line is malformed (longer than 198 characters and
+// holding a control byte included: read_ini_line), a section/key is unknown, a value is not a
+// finite number of the right kind, or a value makes the options invalid; `error` is then
+// "file:line: reason" of the first such line; also iff a section or a key is given twice
 // (IniDuplicates), [sdp] included. An [sdp] section (SDP-SLAM's top level, read by
 // load_sdp_ini in run_sdp.h) is skipped.
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
+// The same from an open stream (read to its end, not closed); `name` stands for the file
+// in messages.
+bool load_config_ini(std::FILE* stream, const std::string& name, SlamConfig* config, std::string* error);
 
 // Opens a configuration file for reading, for every INI reader (this file's, run_sdp.h's
 // and sdpslamd's). Null, with `error` = "path: reason", iff it cannot be opened or is a
 // directory (fopen accepts one on Linux, and reading it looks like an empty file: the
 // built-in defaults would run unannounced). Files, pipes and /dev/null are accepted.
 std::FILE* open_config_file(const std::string& path, std::string* error);
+
+// The line source of every INI reader above, for inih's ini_parse_stream (an ini_reader
+// with the stream passed separately). inih reads with fgets into a buffer of `num` bytes
+// and parses each piece as a line of its own, so a longer line would be cut: its first
+// piece applied as a value, its rest parsed as the next line and every later line number
+// shifted. Here a physical line is read whole: str gets it, '\n' included, and one longer
+// than num - 2 characters (before its '\n') or holding a control byte other than tab
+// and CR (a NUL would end the text inih sees; any of them means a binary file, whose
+// bytes must not be echoed to a terminal in a message) is refused: `why` says so and str gets an empty line, so that inih's
+// count of lines stays the file's. Returns str, or null at the end of the stream (or a
+// read error: see std::ferror). num >= 2.
+char* read_ini_line(std::FILE* stream, char* str, int num, std::string* why);
 
 // A section given twice, or a key given twice in one section, makes a file mean what its
 // last occurrence says, which nobody reading the first one expects: every INI reader

@@ -20,6 +20,7 @@
 //                     non-deterministic fields (wall time, per-scan times, RSS).
 // Same log, options and seed -> bit-identical trajectory.txt, map and icp_error.csv.
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -67,8 +68,13 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
 // kInvalid (malformed value or out of range; *why says why).
 enum class SdpKeyResult { kApplied, kUnknown, kInvalid };
 SdpKeyResult apply_sdp_key(SdpOptions* options, const std::string& key, const char* value, std::string* why);
-// Reads only the [sdp] section of an INI file (other sections are ignored). False iff the
-// file cannot be read or an [sdp] line is malformed/unknown/out of range ("file:line: why").
+// Reads only the [sdp] section of an INI file (the keys of other sections are ignored).
+// False iff the file cannot be read, a line is malformed (read_ini_line in config_ini.h
+// included) or an [sdp] key is unknown or its value malformed / out of range; `error` is
+// then "file:line: why" of the first such line.
 bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error);
+// The same from an open stream (read to its end, not closed); `name` stands for the file
+// in messages.
+bool load_sdp_ini(std::FILE* stream, const std::string& name, SdpOptions* options, std::string* error);
 
 }  // namespace sdpslam::slam

@@ -1,0 +1,63 @@
+// libFuzzer: the map reader of `sdpslam evaluate --map` (io::read_map_pgm_yaml) through
+// its two halves: the input up to its first NUL byte is the YAML, the rest the PGM it
+// names. The PGM is decoded with the YAML's geometry and thresholds when the YAML is
+// accepted, else with the writer's defaults, so that both halves are always exercised.
+// Checks beyond the sanitizers: an accepted YAML has a positive finite resolution, a
+// finite origin, an image name and thresholds 0 <= free < occupied <= 1; a decoded map
+// has width x height cells, each unknown (-1) or an occupancy in [0, 1] outside the
+// open interval (free_thresh, occupied_thresh).
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <string>
+
+#include "sdpslam/io/map_image.h"
+#include "fuzz_text.h"
+
+namespace {
+
+using sdpslam::test::fuzz::check;
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string input(reinterpret_cast<const char*>(data), size);
+  const std::size_t nul = input.find('\0');
+  std::istringstream yaml_text(input.substr(0, nul));
+  const std::string pgm = nul == std::string::npos ? std::string() : input.substr(nul + 1U);
+
+  sdpslam::io::MapYaml yaml;
+  std::string error;
+  if (sdpslam::io::parse_map_yaml(yaml_text, "fuzz.yaml", &yaml, &error)) {
+    check(!yaml.image.empty());
+    check(yaml.resolution_m > 0.0 && std::isfinite(yaml.resolution_m));
+    check(std::isfinite(yaml.origin_x_m) && std::isfinite(yaml.origin_y_m));
+    const sdpslam::io::MapWriteOptions& t = yaml.thresholds;
+    check(t.free_thresh >= 0.0 && t.free_thresh < t.occupied_thresh && t.occupied_thresh <= 1.0);
+  } else {
+    check(error.compare(0, 9, "fuzz.yaml") == 0);
+    yaml = sdpslam::io::MapYaml{};
+    yaml.image = "fuzz.pgm";
+    yaml.resolution_m = 0.05;
+  }
+
+  sdpslam::io::OccupancyImage map;
+  error.clear();
+  if (sdpslam::io::decode_map_pgm(pgm, "fuzz.pgm", yaml, &map, &error)) {
+    check(map.width >= 1U && map.height >= 1U);
+    check(map.occupancy.size() == static_cast<std::size_t>(map.width) * map.height);
+    check(map.occupancy.size() <= pgm.size());
+    check(map.resolution_m == yaml.resolution_m);
+    const sdpslam::io::MapWriteOptions& t = yaml.thresholds;
+    for (const float p : map.occupancy) {
+      if (p == -1.0F) continue;
+      check(p >= 0.0F && p <= 1.0F);
+      check(!(p > t.free_thresh && p < t.occupied_thresh));
+    }
+  } else {
+    check(error.compare(0, 10, "fuzz.pgm: ") == 0);
+    check(map.width == 0U && map.occupancy.empty());
+  }
+  return 0;
+}
