@@ -35,6 +35,8 @@ struct ParseState {
   std::FILE* stream = nullptr;
   int line = 0;
   slam::IniDuplicates duplicates;
+  int first_sdp_line = 0;  // the first [sdp] key and the [slam] profile key, for mode dpslam's warning
+  int profile_line = 0;
 
   void fail(const std::string& why) {
     if (!error.empty()) return;
@@ -393,6 +395,8 @@ int handler(void* user, const char* section, const char* name, const char* value
     if (known_section(sec)) return 1;
     why = "unknown section [" + sec + "]";
   } else if (st->duplicates.key(section, name, &why)) {
+    if (sec == "sdp" && st->first_sdp_line == 0) st->first_sdp_line = st->line;
+    if (sec == "slam" && std::strcmp(name, "profile") == 0) st->profile_line = st->line;
     const R r = handle_key(*st->config, sec, name, value, &why);
     if (r == R::kOk) return 1;
     if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
@@ -446,6 +450,19 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
   if (rc != 0 || std::ferror(f) != 0) {
     *error = path + ": read error";
     return false;
+  }
+  // Keys that only sdp mode reads are not refused in mode dpslam (a file switches mode by
+  // one key), but said to have no effect.
+  config->warnings.clear();
+  if (config->mode == SlamMode::kDpSlam) {
+    if (st.first_sdp_line > 0) {
+      config->warnings.push_back(path + ":" + std::to_string(st.first_sdp_line) +
+                                 ": [sdp] keys have no effect in mode dpslam");
+    }
+    if (st.profile_line > 0) {
+      config->warnings.push_back(path + ":" + std::to_string(st.profile_line) +
+                                 ": slam.profile has no effect in mode dpslam");
+    }
   }
   // Checks that involve several keys, once everything is read.
   const std::string at = path + ": ";

@@ -127,6 +127,7 @@ int run_daemon(int argc, char** argv) {
     std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
     return kExitBadInput;
   }
+  for (const std::string& w : config.warnings) std::fprintf(stderr, "sdpslamd: warning: %s\n", w.c_str());
   if (!out_dir.empty()) config.output_directory = out_dir;
   if (check_only) {
     // The same initialisation as a start (the state allocated and every part set up), so

@@ -439,3 +439,19 @@ TEST(SdpslamdConfig, sdp_mode_of_the_shipped_example_needs_less_memory_than_dpsl
   CHECK(sdp_bytes < dpslam_bytes);
   std::printf("\nexample arena: dpslam %zu B, sdp (60T/%uB) %zu B\n", dpslam_bytes, c.slam.filter.particle_count, sdp_bytes);
 }
+
+// Keys sdp mode alone reads are said to have no effect in mode dpslam, with their line;
+// in sdp mode there is nothing to say.
+TEST(SdpslamdConfig, sdp_keys_in_mode_dpslam_are_warned_about) {
+  DaemonConfig c;
+  std::string error;
+  const std::string path = write_ini("[slam]\nmode = dpslam\nprofile = paper\n\n[sdp]\ntop_particles = 20\n");
+  CHECK_TRUE_TEXT(load_daemon_config(path, &c, &error), error.c_str());
+  LONGS_EQUAL(2, c.warnings.size());
+  STRCMP_EQUAL((path + ":6: [sdp] keys have no effect in mode dpslam").c_str(), c.warnings[0].c_str());
+  STRCMP_EQUAL((path + ":3: slam.profile has no effect in mode dpslam").c_str(), c.warnings[1].c_str());
+  DaemonConfig d;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[slam]\nmode = sdp\n\n[sdp]\ntop_particles = 20\n"), &d, &error),
+                  error.c_str());
+  CHECK_TRUE(d.warnings.empty());
+}

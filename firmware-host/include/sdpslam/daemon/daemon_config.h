@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
@@ -84,6 +85,8 @@ struct DaemonConfig {
   // unit's MemoryMax= (sdpslamd.service) leaves room above it for the rest of the
   // process (drivers, queues, the map rendered for output).
   std::uint32_t memory_budget_mib = 128U;
+  // Set by load_daemon_config: "file:line: ..." for keys the chosen mode does not read.
+  std::vector<std::string> warnings;
 
   static constexpr std::uint32_t kMaxScanQueue = 16U;
 
