@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
               lists > 0U ? static_cast<double>(entries) / static_cast<double>(lists) : 0.0,
               static_cast<unsigned long long>(sink.count),
               static_cast<double>(map.footprint_bytes() + tree.footprint_bytes()) / (1024.0 * 1024.0));
-  std::printf("oom: nodes %u, paths %u, tiles %u, observations %u\n", tree.node_oom_count(), tree.path_oom_count(),
-              map.tile_oom_count(), map.observation_oom_count());
+  std::printf("oom: nodes %u, paths %u, tiles %llu, observations %llu\n", tree.node_oom_count(), tree.path_oom_count(),
+              static_cast<unsigned long long>(map.tile_oom_count()), static_cast<unsigned long long>(map.observation_oom_count()));
   return 0;
 }

@@ -234,10 +234,10 @@ class DpMap final : public TreeListener {
   std::uint32_t observations_used() const { return obs_pool_.size(); }
   std::uint32_t observations_peak() const { return obs_pool_.peak_used(); }
   std::uint32_t observation_capacity() const { return obs_pool_.capacity(); }
-  std::uint32_t tile_oom_count() const { return tile_oom_count_; }
-  std::uint32_t observation_oom_count() const { return observation_oom_count_; }
-  std::uint32_t out_of_bounds_count() const { return out_of_bounds_count_; }
-  std::uint32_t misuse_count() const { return misuse_count_; }
+  std::uint64_t tile_oom_count() const { return tile_oom_count_; }
+  std::uint64_t observation_oom_count() const { return observation_oom_count_; }
+  std::uint64_t out_of_bounds_count() const { return out_of_bounds_count_; }
+  std::uint64_t misuse_count() const { return misuse_count_; }
   // Bytes of state: tile table, tile pool, observation pool, owner tables, index.
   std::size_t footprint_bytes() const;
 
@@ -365,10 +365,10 @@ class DpMap final : public TreeListener {
   std::uint32_t index_shift_ = 63U;  // 64 − log2(slots)
   std::uint32_t node_capacity_ = 0U;
   std::uint32_t touched_tx0_ = kNone, touched_ty0_ = kNone, touched_tx1_ = 0U, touched_ty1_ = 0U;
-  std::uint32_t tile_oom_count_ = 0U;
-  std::uint32_t observation_oom_count_ = 0U;
-  std::uint32_t out_of_bounds_count_ = 0U;
-  std::uint32_t misuse_count_ = 0U;
+  std::uint64_t tile_oom_count_ = 0U;
+  std::uint64_t observation_oom_count_ = 0U;
+  std::uint64_t out_of_bounds_count_ = 0U;
+  std::uint64_t misuse_count_ = 0U;
 };
 
 template <class F>
