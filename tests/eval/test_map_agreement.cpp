@@ -154,19 +154,40 @@ TEST(MapRead, a_pixel_above_maxval_is_refused) {
   LONGS_EQUAL(0, r.width);
 }
 
-// Found by fuzz_map_yaml_pgm: pixel 14 of maxval 40 is occupancy 0.65, occupied at the
-// default occupied_thresh, but was kept as 0.6499999762F, which MapAgreement (wall iff
-// occupancy >= occupied_thresh) took for no wall.
-TEST(MapRead, a_cell_on_a_threshold_keeps_its_class_in_float) {
+// map_server's rule at the thresholds: pixel 14 of maxval 40 is occupancy exactly 0.65,
+// on occupied_thresh, and pixel 32 exactly 0.2, on free_thresh: both unknown.
+TEST(MapRead, a_cell_exactly_on_a_threshold_is_unknown) {
+  OccupancyImage r;
+  std::string error;
+  put("on.pgm", "P5 2 1 40\n\x0e\x20");
+  const std::string yaml = put("on.yaml", "image: on.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n"
+                                          "occupied_thresh: 0.65\nfree_thresh: 0.2\n");
+  CHECK_TRUE_TEXT(sdpslam::io::read_map_pgm_yaml(yaml, &r, nullptr, &error), error.c_str());
+  LONGS_EQUAL(2, r.occupancy.size());
+  DOUBLES_EQUAL(-1.0, r.occupancy[0], 0.0);
+  DOUBLES_EQUAL(-1.0, r.occupancy[1], 0.0);
+}
+
+// Found by fuzz_map_yaml_pgm: a class decided in double was lost in the float kept.
+// Occupancy 0.65 (pixel 14 of 40) is above occupied_thresh 0.64999999 but rounds to
+// 0.6499999762F, below it; 0.2 (pixel 32 of 40) is below free_thresh 0.2000000001 but
+// rounds to 0.2000000030F, above it. Each float must stay in its class, as a reader
+// applying the same rule (MapAgreement) sees it.
+TEST(MapRead, a_cell_next_to_a_threshold_keeps_its_class_in_float) {
   OccupancyImage r;
   MapWriteOptions t;
   std::string error;
-  put("edge.pgm", "P5 1 1 40\n\x0e");
-  const std::string yaml = put("edge.yaml", "image: edge.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n");
+  put("edge.pgm", "P5 2 1 40\n\x0e\x20");
+  const std::string yaml = put("edge.yaml", "image: edge.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n"
+                                            "occupied_thresh: 0.64999999\nfree_thresh: 0.2000000001\n");
   CHECK_TRUE_TEXT(sdpslam::io::read_map_pgm_yaml(yaml, &r, &t, &error), error.c_str());
-  LONGS_EQUAL(1, r.occupancy.size());
-  CHECK_TRUE(r.occupancy[0] >= t.occupied_thresh);
+  LONGS_EQUAL(2, r.occupancy.size());
+  CHECK_TRUE(static_cast<float>(0.65) < t.occupied_thresh);  // the rounding this test is about
+  CHECK_TRUE(static_cast<float>(0.2) > t.free_thresh);
+  CHECK_TRUE(r.occupancy[0] > t.occupied_thresh);
   DOUBLES_EQUAL(0.65, r.occupancy[0], 1e-7);
+  CHECK_TRUE(r.occupancy[1] >= 0.0F && r.occupancy[1] < t.free_thresh);
+  DOUBLES_EQUAL(0.2, r.occupancy[1], 1e-7);
 }
 
 // A header ending the file without the whitespace after maxval: the count of bytes

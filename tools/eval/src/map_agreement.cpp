@@ -10,7 +10,7 @@ namespace sdpslam::eval {
 MapAgreement::MapAgreement(const io::OccupancyImage& map, double occupied_thresh)
     : map_(map), wall_(map.occupancy.size(), 0U) {
   for (std::size_t i = 0; i < map.occupancy.size(); ++i) {
-    wall_[i] = map.occupancy[i] >= 0.0F && map.occupancy[i] >= occupied_thresh ? 1U : 0U;
+    wall_[i] = map.occupancy[i] >= 0.0F && map.occupancy[i] > occupied_thresh ? 1U : 0U;
   }
 }
 

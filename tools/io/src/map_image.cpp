@@ -460,15 +460,23 @@ bool decode_map_pgm(const std::string& data, const std::string& pgm_path, const 
                               "pixel " + std::to_string(src + c - pos) + " is " + std::to_string(pixel) +
                                   ", above maxval " + std::to_string(maxval));
       }
-      const double v = pixel / static_cast<double>(maxval);
-      const double p = t.negate ? v : 1.0 - v;
-      if (p > t.free_thresh && p < t.occupied_thresh) continue;  // unknown
+      // One rounding only: (maxval - v) / maxval, not 1 - v / maxval (8/40 is the double
+      // nearest 0.2; 1 - 32/40 is below it).
+      const long level = t.negate ? static_cast<long>(pixel) : maxval - static_cast<long>(pixel);
+      const double p = static_cast<double>(level) / static_cast<double>(maxval);
+      // map_server's rule: occupied iff p > occupied_thresh, free iff p < free_thresh,
+      // unknown otherwise (a pixel exactly on a threshold is unknown).
+      const bool occupied = p > t.occupied_thresh;
+      const bool free = p < t.free_thresh;
+      if (!occupied && !free) continue;
       // The class is decided in double; the float kept must fall in the same class for a
-      // reader that compares it with the thresholds (eval::MapAgreement). At a threshold
-      // rounding may cross it (0.65 becomes 0.6499999762F): the next float inward is kept.
+      // reader that applies the same rule to it (eval::MapAgreement). Rounding to float
+      // can cross a threshold given in the YAML (p = 0.65 becomes 0.6499999762F, below
+      // occupied_thresh 0.64999999): the next float outward is then kept, which is past
+      // p and so past the threshold.
       float kept = static_cast<float>(p);
-      if (p >= t.occupied_thresh && kept < t.occupied_thresh) kept = std::nextafter(kept, 2.0F);
-      if (p <= t.free_thresh && kept > t.free_thresh) kept = std::nextafter(kept, -1.0F);
+      if (occupied && !(kept > t.occupied_thresh)) kept = std::nextafter(kept, 2.0F);
+      if (free && !(kept < t.free_thresh)) kept = std::nextafter(kept, -1.0F);
       m.occupancy[static_cast<std::size_t>(r) * m.width + c] = kept;
     }
   }

@@ -28,7 +28,7 @@ struct MapAgreementResult {
 
 class MapAgreement {
  public:
-  // Cells with occupancy >= occupied_thresh are walls.
+  // Cells with occupancy > occupied_thresh are walls (map_server's rule).
   MapAgreement(const io::OccupancyImage& map, double occupied_thresh);
   // Casts `scan` from `robot_pose` (the laser at robot_pose ⊕ scan.geometry.laser_in_base).
   void add_scan(const Pose2& robot_pose, const RangeScan& scan);

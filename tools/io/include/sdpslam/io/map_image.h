@@ -37,8 +37,10 @@ bool write_map_pgm_yaml(const std::string& stem, const OccupancyImage& map, cons
 // Reads a map written in the map_server convention: the YAML at `yaml_path` (image,
 // resolution, origin, negate, occupied_thresh, free_thresh; other keys ignored) and the
 // binary PGM (P5, maxval <= 255) it names, relative to the YAML's folder. A pixel's
-// occupancy is (maxval - v) / maxval (v / maxval with negate); one strictly between
-// free_thresh and occupied_thresh is unknown (-1), as map_server reads it. `thresholds`
+// occupancy p is (maxval - v) / maxval (v / maxval with negate); as map_server reads it,
+// p > occupied_thresh is occupied, p < free_thresh free, anything else unknown (-1). A
+// known cell's float keeps its class: occupancy > occupied_thresh or < free_thresh
+// compared in double, whatever the thresholds' digits. `thresholds`
 // (may be null) gets the YAML's. False, with "file[:line]: why" in `error`, on a missing
 // file or key, a bad value, a short image or a pixel above maxval.
 bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
