@@ -253,7 +253,7 @@ bool Daemon::write_outputs() {
       io_.engine->map_image(&image);
       ok = slam::write_trajectory_and_map(outputs_.staging_dir(), trajectory, image, &error);
     } else {
-      ok = io::write_trajectory(outputs_.path("trajectory.txt"), trajectory, &error);
+      ok = slam::write_trajectories(outputs_.staging_dir(), trajectory, &error);
     }
     ok = ok && outputs_.commit(&error);
   } else {

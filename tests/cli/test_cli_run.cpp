@@ -10,8 +10,10 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/trajectory_io.h"
 #include "run_program.h"
 #include "shared_data.h"
 
@@ -173,6 +175,34 @@ TEST(CliRun, outputs_are_one_run_s_set) {
   m2 << dp_manifest.rdbuf();
   CHECK_TEXT(m2.str().find("icp_error") == std::string::npos, m2.str().c_str());
   STRCMP_CONTAINS(" stats.json\n", m2.str().c_str());
+}
+
+// trajectory.tum holds the poses of trajectory.txt (TUM, as evo reads it), in both modes,
+// and is part of the run's set.
+TEST(CliRun, the_trajectory_is_also_written_in_tum_format) {
+  const std::string log = log_with_bad_lines(0);
+  for (const char* mode : {"sdp", "dpslam"}) {
+    const std::string out = dir + "/out-" + mode;
+    Run r = run_cli("run " + log + " --mode " + mode + " --out " + out);
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    std::vector<sdpslam::io::StampedPose> txt;
+    std::vector<sdpslam::io::StampedPose> tum;
+    std::string error;
+    CHECK_TRUE_TEXT(sdpslam::io::read_trajectory(out + "/trajectory.txt", &txt, &error), error.c_str());
+    CHECK_TRUE_TEXT(sdpslam::io::read_trajectory(out + "/trajectory.tum", &tum, &error), error.c_str());
+    LONGS_EQUAL_TEXT(10, txt.size(), mode);
+    LONGS_EQUAL_TEXT(txt.size(), tum.size(), mode);
+    for (std::size_t i = 0; i < txt.size(); ++i) {
+      LONGS_EQUAL(txt[i].stamp_us, tum[i].stamp_us);
+      DOUBLES_EQUAL(txt[i].pose.x_m, tum[i].pose.x_m, 1e-6);
+      DOUBLES_EQUAL(txt[i].pose.y_m, tum[i].pose.y_m, 1e-6);
+      DOUBLES_EQUAL(txt[i].pose.heading_rad, tum[i].pose.heading_rad, 1e-6);
+    }
+    std::ifstream manifest(out + "/manifest.txt");
+    std::stringstream m;
+    m << manifest.rdbuf();
+    STRCMP_CONTAINS(" trajectory.tum\n", m.str().c_str());
+  }
 }
 
 namespace {

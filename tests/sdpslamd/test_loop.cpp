@@ -306,6 +306,10 @@ TEST(SdpslamdLoop, finish_places_what_it_can_and_writes_outputs_atomically) {
   std::string error;
   CHECK_TRUE_TEXT(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error), error.c_str());
   LONGS_EQUAL(1, t.size());
+  std::vector<io::StampedPose> tum;
+  CHECK_TRUE_TEXT(io::read_trajectory(r.config.output_directory + "/trajectory.tum", &tum, &error), error.c_str());
+  LONGS_EQUAL(1, tum.size());
+  LONGS_EQUAL(t[0].stamp_us, tum[0].stamp_us);
   LONGS_EQUAL(1, r.d->counters().scans_skipped_no_odometry);
   CHECK_TRUE(file_exists(r.config.output_directory + "/status.json"));
   LONGS_EQUAL(0, temp_files_in(r.config.output_directory));

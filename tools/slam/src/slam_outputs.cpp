@@ -61,9 +61,15 @@ std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* ima
   return known_cells;
 }
 
+bool write_trajectories(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
+                        std::string* error) {
+  return io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error) &&
+         io::write_trajectory_tum(out_dir + "/trajectory.tum", trajectory, error);
+}
+
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                               const io::OccupancyImage& image, std::string* error) {
-  if (!io::write_trajectory(out_dir + "/trajectory.txt", trajectory, error)) return false;
+  if (!write_trajectories(out_dir, trajectory, error)) return false;
   if (image.width > 0U) {
     if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return false;
     if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return false;

@@ -18,7 +18,7 @@
 //      the scan's stamp (for SCIP the sensor's stamp mapped onto our clock, ≈ its last
 //      byte's arrival on an idle line) and minus the moment the driver returned it;
 //   5. watches the sensors' counters and states and logs every change (EventLog);
-//   6. every output_period_us writes trajectory.txt, map.pgm/.yaml/.png and status.json
+//   6. every output_period_us writes trajectory.txt/.tum, map.pgm/.yaml/.png and status.json
 //      into the output directory, each atomically (a failed write keeps the previous file
 //      and is logged and counted; the next period tries again).
 // run() steps until *stop becomes non-zero (SIGINT/SIGTERM), places what can still be

@@ -5,6 +5,7 @@
 //                    processed scans take the final best particle's path, the others
 //                    that pose composed with the odometry since (map frame: the first
 //                    scan's pose is the origin);
+//  - trajectory.tum  the same poses in TUM format (slam_outputs.h write_trajectories);
 //  - map.pgm/.yaml   the best particle's occupancy grid (map_server convention), and
 //    map.png         with the trajectory drawn;
 //  - stats.json      counts, pool high-water marks, exhaustion counters, state memory

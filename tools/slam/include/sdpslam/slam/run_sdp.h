@@ -8,6 +8,7 @@
 //                     combination of submaps: permanent segments, the live levels' chosen
 //                     submaps and the current segment's best particle; scans that were
 //                     not processed take the last estimate composed with the odometry;
+//  - trajectory.tum   the same poses in TUM format (slam_outputs.h write_trajectories);
 //  - map.pgm/.yaml,   the global map (Fig. 3 (j)-(l)): the permanent map (each cell moved
 //    map.png          with its level's corrected frame) plus each
 //                     chosen submap's DP-map view transformed into the global frame,

@@ -44,8 +44,14 @@ std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& 
 // (width 0) when nothing was ever written.
 std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* image);
 
-// Writes out_dir/trajectory.txt and, when the image is not empty, out_dir/map.pgm, map.yaml
-// and map.png. False (with `error`) at the first write that failed; the files already
+// Writes the trajectory twice: out_dir/trajectory.txt ("t x y theta") and
+// out_dir/trajectory.tum (TUM RGB-D: "t x y z qx qy qz qw", z = 0, a rotation about z),
+// which evo and the TUM tools read. False (with `error`) at the first write that failed.
+bool write_trajectories(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
+                        std::string* error);
+
+// Writes the trajectories (write_trajectories) and, when the image is not empty,
+// out_dir/map.pgm, map.yaml and map.png. False (with `error`) at the first write that failed; the files already
 // written and the previous versions of the others stay complete.
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                               const io::OccupancyImage& image, std::string* error);
