@@ -169,10 +169,9 @@ set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DEV_DESCRIPTION "Segmented DP-SLAM library: headers, static libraries, CMake package
 find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal, sdpslam::drivers
 and sdpslam::io. The libraries are static: the core is linked into the robot's firmware.")
-# The CMake package finds these (sdpslamConfig.cmake).
-set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3)")
+# The CMake package finds these (sdpslamConfig.cmake); the core needs nothing.
 if(SDPSLAM_EXPORTS_IO)
-  string(APPEND CPACK_DEBIAN_DEV_PACKAGE_DEPENDS ", libpng-dev, zlib1g-dev")
+  set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, zlib1g-dev")
 endif()
 
 # Depends of the programs. Natively dpkg-shlibdeps computes them from the binaries. A

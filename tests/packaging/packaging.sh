@@ -186,7 +186,7 @@ contents)
   srcdir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$dir/CMakeCache.txt")
   grep -qF -e "$srcdir" -e "$dir" "$stage"/dev/usr/lib/"$t"/cmake/sdpslam/*.cmake \
     && bad "the CMake package names a path of the build machine"
-  dpkg-deb -f "$dev" Depends | grep -q libeigen3-dev || bad "libsdpslam-dev does not depend on libeigen3-dev"
+  ! dpkg-deb -f "$dev" Depends | grep -q libeigen3-dev || bad "libsdpslam-dev depends on libeigen3-dev, which nothing uses"
   [ -z "$(find "$stage/dev" -name '*.so*')" ] || bad "libsdpslam-dev ships a shared library"
 
   for deb in "$rt" "$dev"; do
