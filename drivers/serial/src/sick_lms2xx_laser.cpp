@@ -18,7 +18,7 @@ bool validate(const SickOptions& o) {
 
 SickLms2xxLaser::SickLms2xxLaser(hal::ByteStream& stream, const hal::MonotonicClock& clock,
                                  const SickOptions& options)
-    : stream_(stream), clock_(clock), options_(options) {
+    : SerialLaserLoop(stream, clock), options_(options) {
   if (!validate(options_)) {
     options_.target_baud = 9600U;
     options_.angle_deg = 180U;
@@ -160,78 +160,22 @@ void SickLms2xxLaser::on_telegram(std::int64_t now_us, RangeScan& out, bool* pro
   }
 }
 
-int SickLms2xxLaser::poll(RangeScan& out, std::int64_t timeout_us) {
-  const std::int64_t deadline = clock_.now_us() + (timeout_us > 0 ? timeout_us : 0);
-  for (;;) {
-    std::int64_t now = clock_.now_us();
-    if (stream_.state() != hal::StreamState::kOpen) {
-      if (!disconnected_) {
-        disconnected_ = true;
-        ++stats_.disconnect_count;
-      }
-      health_ = hal::RangeSourceHealth::kDisconnected;
-      rx_pos_ = rx_len_ = 0U;
-      (void)stream_.wait_readable(deadline > now ? deadline - now : 0);
-      if (stream_.state() != hal::StreamState::kOpen) return -1;
-      continue;
+bool SickLms2xxLaser::drain(std::int64_t now_us, RangeScan& out) {
+  while (rx_pos_ < rx_len_) {
+    std::size_t used = 0U;
+    const auto ev = parser_.feed(rx_ + rx_pos_, rx_len_ - rx_pos_, &used);
+    rx_pos_ += used;
+    if (ev == lms2xx::Parser::Event::kTelegram) {
+      bool produced = false;
+      on_telegram(now_us, out, &produced);
+      if (produced) return true;
+    } else if (ev == lms2xx::Parser::Event::kNak) {
+      if (awaiting_) retry_or_restart(now_us, false);
+    } else if (ev == lms2xx::Parser::Event::kError) {
+      if (parser_.last_error() == lms2xx::Error::kCrc && step_ == Step::kStreaming) ++stats_.dropped_scan_count;
     }
-    if (!sequence_started_ || stream_.stats().open_count != seen_open_count_) {
-      if (sequence_started_) ++stats_.restart_count;
-      seen_open_count_ = stream_.stats().open_count;
-      disconnected_ = false;
-      begin_sequence(now);
-    }
-    while (rx_pos_ < rx_len_) {
-      std::size_t used = 0U;
-      const auto ev = parser_.feed(rx_ + rx_pos_, rx_len_ - rx_pos_, &used);
-      rx_pos_ += used;
-      if (ev == lms2xx::Parser::Event::kTelegram) {
-        bool produced = false;
-        on_telegram(now, out, &produced);
-        if (produced) {
-          sync_parser_stats();
-          return 1;
-        }
-      } else if (ev == lms2xx::Parser::Event::kNak) {
-        if (awaiting_) retry_or_restart(now, false);
-      } else if (ev == lms2xx::Parser::Event::kError) {
-        if (parser_.last_error() == lms2xx::Error::kCrc && step_ == Step::kStreaming) ++stats_.dropped_scan_count;
-      }
-    }
-    sync_parser_stats();
-    now = clock_.now_us();
-    if (!awaiting_ && step_ != Step::kStreaming) send_step(now);
-    const std::int32_t n = stream_.read(rx_, sizeof rx_);
-    if (n > 0) {
-      rx_pos_ = 0U;
-      rx_len_ = static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0) continue;
-    // Nothing is pending: only now may silence count as a reply timeout or a stall. A
-    // poll that was held off (a loaded machine, a long SLAM step) reads its backlog
-    // first; judged before that, a healthy sensor would be restarted and its buffered
-    // scans thrown away.
-    if (awaiting_ && now >= step_deadline_us_) {
-      ++stats_.timeout_count;
-      retry_or_restart(now, true);
-      continue;
-    }
-    if (step_ == Step::kStreaming && now - last_scan_us_ >= options_.stall_timeout_us) {
-      ++stats_.stall_count;
-      ++stats_.restart_count;
-      begin_sequence(now);
-      health_ = hal::RangeSourceHealth::kStalled;
-      continue;
-    }
-    if (now >= deadline) return 0;
-    std::int64_t wake = deadline;
-    if (awaiting_ && step_deadline_us_ < wake) wake = step_deadline_us_;
-    if (step_ == Step::kStreaming && last_scan_us_ + options_.stall_timeout_us < wake) {
-      wake = last_scan_us_ + options_.stall_timeout_us;
-    }
-    (void)stream_.wait_readable(wake > now ? wake - now : 0);
   }
+  return false;
 }
 
 }  // namespace sdpslam::drivers

@@ -12,7 +12,7 @@ constexpr double kTwoPi = 6.28318530717958647692;
 
 UrgScip2Laser::UrgScip2Laser(hal::ByteStream& stream, const hal::MonotonicClock& clock,
                              const UrgOptions& options)
-    : stream_(stream), clock_(clock), options_(options) {
+    : SerialLaserLoop(stream, clock), options_(options) {
   if (options_.cluster == 0U || options_.cluster > 99U) options_.cluster = 1U;
 }
 
@@ -151,76 +151,20 @@ void UrgScip2Laser::on_reply(std::int64_t now_us, RangeScan& out, bool* produced
   }
 }
 
-int UrgScip2Laser::poll(RangeScan& out, std::int64_t timeout_us) {
-  const std::int64_t deadline = clock_.now_us() + (timeout_us > 0 ? timeout_us : 0);
-  for (;;) {
-    std::int64_t now = clock_.now_us();
-    if (stream_.state() != hal::StreamState::kOpen) {
-      if (!disconnected_) {
-        disconnected_ = true;
-        ++stats_.disconnect_count;
-      }
-      health_ = hal::RangeSourceHealth::kDisconnected;
-      rx_pos_ = rx_len_ = 0U;
-      (void)stream_.wait_readable(deadline > now ? deadline - now : 0);
-      if (stream_.state() != hal::StreamState::kOpen) return -1;
-      continue;
+bool UrgScip2Laser::drain(std::int64_t now_us, RangeScan& out) {
+  while (rx_pos_ < rx_len_) {
+    std::size_t used = 0U;
+    const auto ev = parser_.feed(rx_ + rx_pos_, rx_len_ - rx_pos_, &used);
+    rx_pos_ += used;
+    if (ev == scip2::Parser::Event::kReply) {
+      bool produced = false;
+      on_reply(now_us, out, &produced);
+      if (produced) return true;
+    } else if (ev == scip2::Parser::Event::kError && step_ == Step::kStreaming) {
+      ++stats_.dropped_scan_count;  // while streaming, a broken reply is a lost scan
     }
-    if (!sequence_started_ || stream_.stats().open_count != seen_open_count_) {
-      if (sequence_started_) ++stats_.restart_count;
-      seen_open_count_ = stream_.stats().open_count;
-      disconnected_ = false;
-      begin_sequence(now);
-    }
-    while (rx_pos_ < rx_len_) {
-      std::size_t used = 0U;
-      const auto ev = parser_.feed(rx_ + rx_pos_, rx_len_ - rx_pos_, &used);
-      rx_pos_ += used;
-      if (ev == scip2::Parser::Event::kReply) {
-        bool produced = false;
-        on_reply(now, out, &produced);
-        if (produced) {
-          sync_parser_stats();
-          return 1;
-        }
-      } else if (ev == scip2::Parser::Event::kError && step_ == Step::kStreaming) {
-        ++stats_.dropped_scan_count;  // while streaming, a broken reply is a lost scan
-      }
-    }
-    sync_parser_stats();
-    now = clock_.now_us();
-    if (!awaiting_ && step_ != Step::kStreaming) send_step(now);
-    const std::int32_t n = stream_.read(rx_, sizeof rx_);
-    if (n > 0) {
-      rx_pos_ = 0U;
-      rx_len_ = static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0) continue;
-    // Nothing is pending: only now may silence count as a reply timeout or a stall. A
-    // poll that was held off (a loaded machine, a long SLAM step) reads its backlog
-    // first; judged before that, a healthy sensor would be restarted and its buffered
-    // scans thrown away.
-    if (awaiting_ && now >= step_deadline_us_) {
-      ++stats_.timeout_count;
-      retry_or_restart(now);
-      continue;
-    }
-    if (step_ == Step::kStreaming && now - last_scan_us_ >= options_.stall_timeout_us) {
-      ++stats_.stall_count;
-      ++stats_.restart_count;
-      begin_sequence(now);
-      health_ = hal::RangeSourceHealth::kStalled;
-      continue;
-    }
-    if (now >= deadline) return 0;
-    std::int64_t wake = deadline;
-    if (awaiting_ && step_deadline_us_ < wake) wake = step_deadline_us_;
-    if (step_ == Step::kStreaming && last_scan_us_ + options_.stall_timeout_us < wake) {
-      wake = last_scan_us_ + options_.stall_timeout_us;
-    }
-    (void)stream_.wait_readable(wake > now ? wake - now : 0);
   }
+  return false;
 }
 
 }  // namespace sdpslam::drivers

@@ -19,6 +19,7 @@
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/drivers/lms2xx.h"
+#include "sdpslam/drivers/serial_laser_loop.h"
 #include "sdpslam/hal/byte_stream.h"
 #include "sdpslam/hal/clock.h"
 #include "sdpslam/hal/range_scan_source.h"
@@ -38,46 +39,35 @@ struct SickOptions {
 // False iff the options name a rate/variant the LMS2xx does not offer.
 bool validate(const SickOptions& options);
 
-class SickLms2xxLaser final : public hal::RangeScanSource {
+class SickLms2xxLaser final : public SerialLaserLoop<SickLms2xxLaser, 1024U> {
  public:
   SickLms2xxLaser(hal::ByteStream& stream, const hal::MonotonicClock& clock, const SickOptions& options);
-
-  int poll(RangeScan& out, std::int64_t timeout_us) override;
-  hal::RangeSourceHealth health() const override { return health_; }
-  const hal::RangeSourceStats& stats() const override { return stats_; }
   const lms2xx::ParserStats& parser_stats() const { return parser_.stats(); }
   // Values per scan the configured variant yields (361 for 180 deg / 0.5 deg).
   std::uint32_t expected_values() const;
 
  private:
+  friend class SerialLaserLoop<SickLms2xxLaser, 1024U>;
   enum class Step : std::uint8_t { kStop, kBaud, kVariant, kStream, kStreaming };
+  // The loop's hooks (serial_laser_loop.h).
   void begin_sequence(std::int64_t now_us);
   void send_step(std::int64_t now_us);
+  bool streaming() const { return step_ == Step::kStreaming; }
+  bool drain(std::int64_t now_us, RangeScan& out);
+  void on_reply_timeout(std::int64_t now_us) { retry_or_restart(now_us, true); }
+  std::int64_t stall_timeout_us() const { return options_.stall_timeout_us; }
   void on_telegram(std::int64_t now_us, RangeScan& out, bool* produced);
   void step_done(std::int64_t now_us);
   void retry_or_restart(std::int64_t now_us, bool timed_out);
   void sync_parser_stats();
 
-  hal::ByteStream& stream_;
-  const hal::MonotonicClock& clock_;
   SickOptions options_;
   lms2xx::Parser parser_{lms2xx::Parser::Source::kScanner};
   lms2xx::MeasuredValues values_;
   Step step_ = Step::kStop;
-  bool awaiting_ = false;
   std::uint32_t retries_ = 0U;
   std::uint32_t probe_index_ = 0U;
-  std::int64_t step_deadline_us_ = 0;
-  std::int64_t last_scan_us_ = 0;
-  std::uint64_t seen_open_count_ = 0U;
   std::uint64_t decode_error_count_ = 0U;  // valid-CRC B0 telegrams that fail decode_b0
-  bool sequence_started_ = false;
-  bool disconnected_ = false;
-  std::uint8_t rx_[1024] = {};
-  std::size_t rx_pos_ = 0U;
-  std::size_t rx_len_ = 0U;
-  hal::RangeSourceHealth health_ = hal::RangeSourceHealth::kStarting;
-  hal::RangeSourceStats stats_;
 };
 
 }  // namespace sdpslam::drivers

@@ -17,6 +17,7 @@
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/drivers/scip2.h"
+#include "sdpslam/drivers/serial_laser_loop.h"
 #include "sdpslam/hal/byte_stream.h"
 #include "sdpslam/hal/clock.h"
 #include "sdpslam/hal/range_scan_source.h"
@@ -31,13 +32,9 @@ struct UrgOptions {
   Pose2 laser_in_base;
 };
 
-class UrgScip2Laser final : public hal::RangeScanSource {
+class UrgScip2Laser final : public SerialLaserLoop<UrgScip2Laser, 512U> {
  public:
   UrgScip2Laser(hal::ByteStream& stream, const hal::MonotonicClock& clock, const UrgOptions& options);
-
-  int poll(RangeScan& out, std::int64_t timeout_us) override;
-  hal::RangeSourceHealth health() const override { return health_; }
-  const hal::RangeSourceStats& stats() const override { return stats_; }
 
   // Geometry learnt from PP (zeros before the first PP reply).
   const scip2::SensorParams& sensor_params() const { return params_; }
@@ -46,34 +43,27 @@ class UrgScip2Laser final : public hal::RangeScanSource {
   const scip2::ParserStats& parser_stats() const { return parser_.stats(); }
 
  private:
+  friend class SerialLaserLoop<UrgScip2Laser, 512U>;
   enum class Step : std::uint8_t { kScip2, kQuit, kVersion, kParams, kLaserOn, kStream, kStreaming };
+  // The loop's hooks (serial_laser_loop.h).
   void begin_sequence(std::int64_t now_us);
   void send_step(std::int64_t now_us);
+  bool streaming() const { return step_ == Step::kStreaming; }
+  bool drain(std::int64_t now_us, RangeScan& out);
+  void on_reply_timeout(std::int64_t now_us) { retry_or_restart(now_us); }
+  std::int64_t stall_timeout_us() const { return options_.stall_timeout_us; }
   void on_reply(std::int64_t now_us, RangeScan& out, bool* produced);
   void advance(std::int64_t now_us);
   void retry_or_restart(std::int64_t now_us);
   void sync_parser_stats();
 
-  hal::ByteStream& stream_;
-  const hal::MonotonicClock& clock_;
   UrgOptions options_;
   scip2::Parser parser_;
   scip2::SensorClock sensor_clock_;
   scip2::SensorParams params_;
   char product_[scip2::kMaxParamValueChars + 1] = {};
   Step step_ = Step::kScip2;
-  bool awaiting_ = false;
   std::uint32_t retries_ = 0U;
-  std::int64_t step_deadline_us_ = 0;
-  std::int64_t last_scan_us_ = 0;
-  std::uint64_t seen_open_count_ = 0U;
-  bool sequence_started_ = false;
-  bool disconnected_ = false;
-  std::uint8_t rx_[512] = {};
-  std::size_t rx_pos_ = 0U;
-  std::size_t rx_len_ = 0U;
-  hal::RangeSourceHealth health_ = hal::RangeSourceHealth::kStarting;
-  hal::RangeSourceStats stats_;
 };
 
 }  // namespace sdpslam::drivers
