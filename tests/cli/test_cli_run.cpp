@@ -177,6 +177,29 @@ TEST(CliRun, outputs_are_one_run_s_set) {
   STRCMP_CONTAINS(" stats.json\n", m2.str().c_str());
 }
 
+// On a terminal the progress line is drawn (\r-redrawn, the end once); --quiet draws
+// nothing. A terminal comes from script(1) (util-linux, in every Debian system).
+TEST(CliRun, progress_on_a_terminal_and_quiet) {
+  if (std::system("command -v script > /dev/null 2>&1") != 0) {
+    std::fprintf(stderr, "skipped: no script(1) to give the program a terminal\n");
+    return;
+  }
+  const std::string log = log_with_bad_lines(0);
+  auto on_tty = [&](const std::string& args) {
+    return sdpslam::test::run_program("script -qec \"" + std::string(SDPSLAM_CLI_PATH) + " " + args + "\" /dev/null");
+  };
+  Run r = on_tty("run " + log + " --mode dpslam --out " + dir + "/o1");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("\rKiB ", r.out.c_str());
+  std::size_t ends = 0;
+  for (std::size_t p = r.out.find("100.0%"); p != std::string::npos; p = r.out.find("100.0%", p + 1)) ++ends;
+  LONGS_EQUAL_TEXT(1, ends, r.out.c_str());
+  r = on_tty("run " + log + " --mode dpslam --quiet --out " + dir + "/o2");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  CHECK_TEXT(r.out.find("KiB") == std::string::npos, r.out.c_str());
+  STRCMP_CONTAINS("sdpslam run: ", r.out.c_str());
+}
+
 // trajectory.tum holds the poses of trajectory.txt (TUM, as evo reads it), in both modes,
 // and is part of the run's set.
 TEST(CliRun, the_trajectory_is_also_written_in_tum_format) {

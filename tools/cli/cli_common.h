@@ -51,9 +51,9 @@ class Progress {
  public:
   // On a terminal: one line redrawn at most every 200 ms (done/total, percent, rate,
   // ETA). Otherwise (a file, a pipe, a journal): the same figures as a plain line every
-  // kPlainInterval, so logs stay readable.
+  // kPlainInterval, so logs stay readable. `quiet` (--quiet): nothing at all.
   static constexpr std::chrono::seconds kPlainInterval{10};
-  Progress(std::string what, std::uint64_t total);
+  Progress(std::string what, std::uint64_t total, bool quiet);
   ~Progress();
   void update(std::uint64_t done);
   void finish();
@@ -62,7 +62,9 @@ class Progress {
   std::string what_;
   std::uint64_t total_;
   bool terminal_;
+  bool quiet_;
   bool finished_ = false;
+  std::uint64_t drawn_ = 0;  // done at the last draw
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };

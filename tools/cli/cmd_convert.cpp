@@ -17,6 +17,7 @@ constexpr std::size_t kErrorsPrinted = 20;
 
 struct ConvertArgs {
   std::string in;
+  bool quiet = false;
   std::string out;
   std::string format = "auto";
   io::WheelOdometryParams wheels;
@@ -43,7 +44,7 @@ int run_convert(const ConvertArgs& a) {
   }
   writer.comment("converted by sdpslam from " + a.in + " (" + io::to_string(reader.format()) + ")");
 
-  Progress progress("KiB", file_size_kib(a.in));
+  Progress progress("KiB", file_size_kib(a.in), a.quiet);
   std::uint64_t lasers = 0;
   std::uint64_t odoms = 0;
   std::uint64_t params = 0;
@@ -95,6 +96,7 @@ std::function<int()> setup_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
   app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted)")->required();
   app.add_option("OUT", args->out, "output CARMEN log (written atomically)")->required();
+  app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   app.add_option("--format", args->format, "input format")
       ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam"}))
       ->capture_default_str();

@@ -20,6 +20,7 @@ namespace {
 
 struct RunArgs {
   std::string log;
+  bool quiet = false;
   std::string mode = "sdp";
   std::uint32_t particles = 0U;      // 0 = from the config (sdp: the profile's 10 unless the file says)
   std::uint32_t top_particles = 0U;  // 0 = from the sdp config (60)
@@ -101,7 +102,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
     return report("", kExitUsage, why);
   }
   ro.seed = a.seed;
-  Progress progress("KiB", file_size_kib(a.log));
+  Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::SdpRunSummary s;
   const slam::SdpRunStatus status = slam::run_sdp_offline(a.log, ro, a.out, &s, &error);
@@ -131,7 +132,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
   ro.seed = a.seed;
-  Progress progress("KiB", file_size_kib(a.log));
+  Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::RunSummary summary;
   std::string error;
@@ -172,6 +173,7 @@ std::function<int()> setup_run(CLI::App& app) {
                  "INI options on top of the profile: bottom level and [sdp] (see tools/slam/default.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)");
   app.add_option("--out", args->out, "Output directory")->required();
+  app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
     // Options of the top level mean nothing to DP-SLAM alone: refused, not ignored.

@@ -41,6 +41,7 @@ std::string builtin_world_names() {
 
 struct SimulateArgs {
   std::string world = "paper";  // a built-in world's name or a world file
+  bool quiet = false;
   std::string route_path;
   std::string out_dir = "sim";
   double map_resolution_m = 0.05;
@@ -88,7 +89,7 @@ int run_simulate(const SimulateArgs& args) {
   }
 
   const double route_m = sim::route_length_m(route);
-  Progress progress("metres", static_cast<std::uint64_t>(std::ceil(route_m)));
+  Progress progress("metres", static_cast<std::uint64_t>(std::ceil(route_m)), args.quiet);
   const auto on_progress = [&progress](double done_m, double /*total_m*/) {
     progress.update(static_cast<std::uint64_t>(done_m));
   };
@@ -168,6 +169,7 @@ std::function<int()> setup_simulate(CLI::App& app) {
                  "route file: one waypoint 'x y' per line (default: the built-in world's)");
   add_sim_option(app, a, "--seed", [](auto& o) -> auto& { return o.seed; }, "random seed");
   app.add_option("--out", args->out_dir, "output directory")->capture_default_str();
+  app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   add_sim_option(app, a, "--speed", [](auto& o) -> auto& { return o.robot.max_speed_mps; }, "top speed, m/s");
   add_sim_option(app, a, "--accel", [](auto& o) -> auto& { return o.robot.max_accel_mps2; },
                  "acceleration limit, m/s^2");

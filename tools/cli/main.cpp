@@ -29,18 +29,21 @@ std::uint64_t file_size_kib(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) / 1024U : 0U;
 }
 
-Progress::Progress(std::string what, std::uint64_t total)
-    : what_(std::move(what)), total_(total), terminal_(::isatty(STDERR_FILENO) == 1),
+Progress::Progress(std::string what, std::uint64_t total, bool quiet)
+    : what_(std::move(what)), total_(total), terminal_(::isatty(STDERR_FILENO) == 1), quiet_(quiet),
       start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
 
 Progress::~Progress() { finish(); }
 
 void Progress::update(std::uint64_t done) {
-  if (finished_) return;
+  if (finished_ || quiet_) return;
   const auto now = std::chrono::steady_clock::now();
-  if (terminal_ && done < total_ && now - last_draw_ < std::chrono::milliseconds(200)) return;
+  // On a terminal the end (done = total) is drawn at once, but once only.
+  const bool end = done >= total_ && drawn_ < total_;
+  if (terminal_ && !end && now - last_draw_ < std::chrono::milliseconds(200)) return;
   if (!terminal_ && now - last_draw_ < kPlainInterval) return;
   last_draw_ = now;
+  drawn_ = done;
   const double elapsed_s = std::chrono::duration<double>(now - start_).count();
   const double rate = elapsed_s > 0.0 ? static_cast<double>(done) / elapsed_s : 0.0;
   const double pct = total_ > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 0.0;
@@ -55,7 +58,7 @@ void Progress::update(std::uint64_t done) {
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
-  if (terminal_) std::fprintf(stderr, "\n");
+  if (terminal_ && !quiet_) std::fprintf(stderr, "\n");
 }
 
 }  // namespace sdpslam::cli
