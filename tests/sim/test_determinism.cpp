@@ -41,7 +41,7 @@ SimulationOutputs write_run(const std::string& dir, std::uint64_t seed) {
 TEST_GROUP(SimDeterminism){};
 
 TEST(SimDeterminism, rng_streams_of_one_seed_differ_and_repeat) {
-  Rng a(42, 1), b(42, 1), c(42, 2), d(43, 1);
+  sim::Rng a(42, 1), b(42, 1), c(42, 2), d(43, 1);
   const std::uint64_t va = a.next_u64();
   CHECK_EQUAL(va, b.next_u64());
   CHECK(va != c.next_u64());
@@ -49,7 +49,7 @@ TEST(SimDeterminism, rng_streams_of_one_seed_differ_and_repeat) {
 }
 
 TEST(SimDeterminism, rng_uniform_is_in_the_unit_interval_and_gaussian_has_unit_spread) {
-  Rng r(9);
+  sim::Rng r(9);
   double sum = 0.0, sum2 = 0.0;
   const int n = 200000;
   for (int i = 0; i < n; ++i) {

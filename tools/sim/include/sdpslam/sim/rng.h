@@ -1,46 +1,27 @@
 #pragma once
-// The simulator's own random numbers, so that a seed gives bit-identical output on every
-// standard library: splitmix64 (Steele, Lea, Flood 2014) to expand a seed, xoshiro256**
-// (Blackman & Vigna 2018) as the generator, Box–Muller for Gaussians. No std::
-// distributions are used: their output is implementation-defined.
+// The simulator's random numbers: the core's generator (core/rng.h: xoshiro256**
+// seeded through splitmix64), one independent stream per consumer, and Box–Muller for
+// Gaussians. No std:: distributions are used: their output is implementation-defined.
 #include <cmath>
 #include <cstdint>
 
-namespace sdpslam::sim {
+#include "sdpslam/core/rng.h"
 
-// One step of splitmix64: advances *state and returns the next output.
-inline std::uint64_t splitmix64(std::uint64_t* state) {
-  std::uint64_t z = (*state += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31U);
-}
+namespace sdpslam::sim {
 
 class Rng {
  public:
   // `stream` separates independent consumers (odometry, laser) of one user seed, so that
   // changing the laser's settings does not change the odometry's noise.
-  explicit Rng(std::uint64_t seed, std::uint64_t stream = 0) {
-    std::uint64_t sm = seed ^ (stream * 0xD1B54A32D192ED03ULL);
-    for (std::uint64_t& w : s_) w = splitmix64(&sm);
-  }
+  explicit Rng(std::uint64_t seed, std::uint64_t stream = 0) : core_(seed ^ (stream * 0xD1B54A32D192ED03ULL)) {}
 
-  std::uint64_t next_u64() {
-    const std::uint64_t result = rotl(s_[1] * 5U, 7) * 9U;
-    const std::uint64_t t = s_[1] << 17U;
-    s_[2] ^= s_[0];
-    s_[3] ^= s_[1];
-    s_[1] ^= s_[2];
-    s_[0] ^= s_[3];
-    s_[2] ^= t;
-    s_[3] = rotl(s_[3], 45);
-    return result;
-  }
-
+  std::uint64_t next_u64() { return core_.next_u64(); }
   // Uniform in [0, 1), 53 random bits.
-  double uniform() { return static_cast<double>(next_u64() >> 11U) * 0x1.0p-53; }
+  double uniform() { return core_.uniform(); }
 
-  // Standard normal by Box–Muller; both outputs of a pair are used.
+  // Standard normal by Box–Muller; both outputs of a pair are used. (Not the core's polar
+  // method: the simulated worlds' noise, and so every benchmark figure on them, is
+  // defined by this sequence.)
   double gaussian() {
     if (have_spare_) {
       have_spare_ = false;
@@ -56,10 +37,7 @@ class Rng {
   }
 
  private:
-  static std::uint64_t rotl(std::uint64_t x, int k) {
-    return (x << static_cast<unsigned>(k)) | (x >> static_cast<unsigned>(64 - k));
-  }
-  std::uint64_t s_[4] = {};
+  sdpslam::Rng core_;
   double spare_ = 0.0;
   bool have_spare_ = false;
 };
