@@ -89,6 +89,36 @@ TEST(CliEvaluate, ate_of_shifted_copy_is_zero) {
   STRCMP_CONTAINS("3 matched", r.out.c_str());
 }
 
+TEST(CliEvaluate, relative_error_of_a_short_copy_names_its_scale) {
+  // 20 m straight at 0.5 m per pose; the estimate covers 90 % of each step.
+  std::string g;
+  std::string e;
+  for (int i = 0; i <= 40; ++i) {
+    g += std::to_string(i + 1) + " " + std::to_string(0.5 * i) + " 0 0\n";
+    e += std::to_string(i + 1) + " " + std::to_string(0.45 * i) + " 0 0\n";
+  }
+  const std::string gt = put("gt.txt", g);
+  const std::string t = put("t.txt", e);
+  const std::string json = dir + "/out.json";
+  const Run r = run_evaluate("--trajectory " + t + " --ground-truth " + gt + " --rpe-m 5 --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("relative    over 31 stretches of 5.000 m: mean 0.500000 m", r.out.c_str());
+  STRCMP_CONTAINS("along-track scale -10.000 %", r.out.c_str());
+  const std::string j = slurp(json);
+  STRCMP_CONTAINS("\"rpe\": {\"distance_m\": 5, \"stretch_count\": 31, \"mean_m\": 0.5", j.c_str());
+  // A path shorter than the stretch is said so; --rpe-m 0 leaves it out; a negative
+  // distance is a usage error.
+  const Run longer = run_evaluate("--trajectory " + t + " --ground-truth " + gt + " --rpe-m 50");
+  LONGS_EQUAL_TEXT(0, longer.status, longer.out.c_str());
+  STRCMP_CONTAINS("relative    not measured: the ground-truth path is shorter than 50.000 m", longer.out.c_str());
+  const Run off = run_evaluate("--trajectory " + t + " --ground-truth " + gt + " --rpe-m 0");
+  LONGS_EQUAL_TEXT(0, off.status, off.out.c_str());
+  CHECK(off.out.find("relative") == std::string::npos);
+  const Run bad = run_evaluate("--trajectory " + t + " --ground-truth " + gt + " --rpe-m -1");
+  LONGS_EQUAL_TEXT(2, bad.status, bad.out.c_str());
+  STRCMP_CONTAINS("--rpe-m", bad.out.c_str());
+}
+
 TEST(CliEvaluate, malformed_trajectory_is_bad_input_with_file_and_line) {
   const std::string bad = put("bad.txt", "1 0 0 0\n2 0 oops 0\n");
   const std::string gt = put("gt.txt", "1 0 0 0\n");

@@ -6,8 +6,10 @@
 //       trajectory has no pose for are filled with the last estimate composed with
 //       odometry (tools/eval/include/sdpslam/eval/relations.h). --odometry evaluates the
 //       log's own odometry poses (the "raw odometry" baseline).
-//   sdpslam evaluate --trajectory TRAJ --ground-truth GT
-//       absolute trajectory error after the best SE(2) alignment.
+//   sdpslam evaluate --trajectory TRAJ --ground-truth GT [--rpe-m D]
+//       absolute trajectory error after the best SE(2) alignment, and the relative
+//       error over every D metres of the ground-truth path (default 10; 0 = not measured):
+//       the local drift, with the along-track scale error (tools/eval/include/sdpslam/eval/rpe.h).
 //   sdpslam evaluate --log LOG --trajectory TRAJ --map MAP.yaml
 //       agreement of the map with the trajectory: the share of the log's laser returns,
 //       cast from the trajectory's poses, that end within one cell of an occupied cell
@@ -28,6 +30,7 @@
 #include "sdpslam/eval/log_scans.h"
 #include "sdpslam/eval/map_agreement.h"
 #include "sdpslam/eval/relations.h"
+#include "sdpslam/eval/rpe.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
@@ -45,6 +48,7 @@ struct EvaluateArgs {
   std::string map_path;
   std::string json_path;
   bool odometry = false;
+  double rpe_m = 10.0;
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
 };
 
@@ -233,6 +237,21 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
            ", \"heading_rmse_deg\": " + json_number(r.heading_rmse_rad * kRadToDeg) +
            ", \"alignment\": {\"x_m\": " + json_number(r.alignment.x_m) + ", \"y_m\": " + json_number(r.alignment.y_m) +
            ", \"heading_rad\": " + json_number(r.alignment.heading_rad) + "}}";
+  if (!(a.rpe_m > 0.0)) return kExitOk;
+  eval::RpeResult q;
+  if (!eval::compute_rpe(estimate, truth, a.tolerance_us, a.rpe_m, &q)) {
+    std::printf("  relative    not measured: the ground-truth path is shorter than %.3f m\n", a.rpe_m);
+    return kExitOk;
+  }
+  std::printf("  relative    over %zu stretches of %.3f m: mean %.6f m, rmse %.6f m, max %.6f m, heading %.6f deg, "
+              "along-track scale %+.3f %%\n",
+              q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
+              100.0 * q.scale_error);
+  *json += ", \"rpe\": {\"distance_m\": " + json_number(q.distance_m) +
+           ", \"stretch_count\": " + std::to_string(q.stretch_count) + ", \"mean_m\": " + json_number(q.mean_m) +
+           ", \"rmse_m\": " + json_number(q.rmse_m) + ", \"max_m\": " + json_number(q.max_m) +
+           ", \"heading_mean_deg\": " + json_number(q.heading_mean_rad * kRadToDeg) +
+           ", \"scale_error\": " + json_number(q.scale_error) + "}";
   return kExitOk;
 }
 
@@ -292,6 +311,10 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --ground-truth needs --trajectory\n");
     return kExitUsage;
   }
+  if (!(a.rpe_m >= 0.0) || a.rpe_m > 1.0e6) {
+    std::fprintf(stderr, "sdpslam evaluate: --rpe-m must be a distance in metres, 0 .. 1e6 (0: not measured)\n");
+    return kExitUsage;
+  }
   if (a.tolerance_us < 0) {
     std::fprintf(stderr, "sdpslam evaluate: --stamp-tolerance-us must not be negative\n");
     return kExitUsage;
@@ -333,6 +356,9 @@ std::function<int()> setup_evaluate(CLI::App& app) {
   app.add_flag("--odometry", args->odometry, "evaluate the log's own odometry poses (raw-odometry baseline)")
       ->excludes(traj);
   app.add_option("--ground-truth", args->ground_truth_path, "ground-truth trajectory for the absolute error");
+  app.add_option("--rpe-m", args->rpe_m,
+                 "with --ground-truth: also the relative error over every stretch of this many metres (default 10, "
+                 "0 = not measured)");
   app.add_option("--map", args->map_path, "map (map_server YAML + PGM) whose agreement with --trajectory to measure");
   app.add_option("--json", args->json_path, "also write the figures to this JSON file");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
