@@ -314,7 +314,8 @@ std::uint32_t AncestryTree::drain_committed(PoseSink& sink) {
   std::uint32_t emitted = 0U;
   for (NodeId r = first_root_; r != kNoNode; r = node(r).next_sibling) {
     Node& n = node(r);
-    if (n.child_count < 2U) continue;
+    const bool sole_leaf = n.child_count == 0U && n.active && r == first_root_ && n.next_sibling == kNoNode;
+    if (n.child_count < 2U && !sole_leaf) continue;
     while (n.path_count > 1U) {  // keep the newest so that last_pose() always answers
       PathEntry* e = paths_.at_index(n.path_head);
       sink.on_committed(e->stamp_us, e->pose);

@@ -280,6 +280,56 @@ TEST(AncestryTree, commitment_emits_shared_poses_and_keeps_the_newest) {
   LONGS_EQUAL(3U, t.committed_count());
 }
 
+TEST(AncestryTree, a_lineage_that_never_branches_commits_as_it_goes) {
+  // One particle: every step a child, the parent retired and merged into it. Its poses
+  // are all the filter has; without commitment they would fill the path pool (4 here)
+  // and the trajectory would be lost.
+  TreeFixture f(4U, 4U);
+  AncestryTree& t = f.tree;
+  NodeId p = t.create_root();
+  Collector sink;
+  for (int step = 1; step <= 20; ++step) {
+    const NodeId c = t.add_child(p);
+    CHECK(c != kNoNode);
+    t.set_active(p, false);
+    t.prune(nullptr);
+    CHECK_TRUE(t.append_pose(c, step, Pose2{}));
+    t.drain_committed(sink);
+    CHECK_TRUE(t.invariants_hold());
+    LONGS_EQUAL(1, t.path_entries_used());  // the newest stays for last_pose()
+    p = c;
+  }
+  LONGS_EQUAL(19U, sink.stamps.size());
+  for (std::size_t k = 0; k < sink.stamps.size(); ++k) LONGS_EQUAL(static_cast<long>(k + 1), sink.stamps[k]);
+  std::int64_t last = 0;
+  CHECK_TRUE(t.last_pose(p, &last, nullptr));
+  LONGS_EQUAL(20, last);
+}
+
+TEST(AncestryTree, a_leaf_root_beside_another_root_keeps_its_poses) {
+  // Two roots (two independent lineages, as segments of SDP-SLAM have): neither holds
+  // what the other's particles share, so nothing is committed from a leaf root.
+  TreeFixture f(8U, 16U);
+  AncestryTree& t = f.tree;
+  const NodeId a = t.create_root();
+  const NodeId b = t.create_root();
+  for (int i = 1; i <= 3; ++i) {
+    t.append_pose(a, i, Pose2{});
+    t.append_pose(b, 10 + i, Pose2{});
+  }
+  Collector sink;
+  LONGS_EQUAL(0, t.drain_committed(sink));
+  LONGS_EQUAL(3, t.pose_count(a));
+  // An inactive sole root with one child is not a lineage of its own either.
+  TreeFixture g(8U, 16U);
+  AncestryTree& u = g.tree;
+  const NodeId r = u.create_root();
+  for (int i = 1; i <= 3; ++i) u.append_pose(r, i, Pose2{});
+  u.add_child(r);
+  u.set_active(r, false);
+  LONGS_EQUAL(0, u.drain_committed(sink));
+}
+
 TEST(AncestryTree, empty_tree_after_everything_dies) {
   TreeFixture f(8U, 8U);
   AncestryTree& t = f.tree;

@@ -206,8 +206,10 @@ class AncestryTree {
   // of that tree and can never change, so they are emitted to `sink` in time order and
   // their entries freed (memory does not grow with run length) — all but the newest,
   // which stays so that last_pose() always has an answer; it is emitted by a later
-  // drain, possibly after a merge carried it into a child. Roots with fewer children
-  // keep theirs. Emitted poses followed by for_each_pose_from_root(leaf) reproduce the
+  // drain, possibly after a merge carried it into a child. The same holds for the only
+  // root of the tree when it is an active leaf: one particle (or all of them, on one
+  // node) whose lineage never branched, e.g. a one-particle filter, which never
+  // resamples. Other roots with fewer than two children keep theirs. Emitted poses followed by for_each_pose_from_root(leaf) reproduce the
   // leaf's full trajectory exactly. Returns the number of poses emitted. O(emitted).
   std::uint32_t drain_committed(PoseSink& sink);
 
