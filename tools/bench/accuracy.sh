@@ -7,7 +7,9 @@
 #   - worlds: `sdpslam simulate --world NAME --seed S` (the seed also draws the sensor
 #     noise, so each seed is a different simulated run), `sdpslam run --seed S` on it, then
 #     the absolute trajectory error against the simulator's ground truth (ATE RMSE after
-#     SE(2) alignment, m). `simulate` has two built-in worlds: "paper", the paper's nested
+#     SE(2) alignment, m) and the relative error per 10 m of path (`sdpslam evaluate`'s
+#     --rpe-m: the local drift, and its along-track part, whatever the loops did).
+#     `simulate` has two built-in worlds: "paper", the paper's nested
 #     28 m / 80 m loops, and "large", a 203 m x 123 m building with 2.26 km of nested loops,
 #     an open hall and featureless corridors, scanned by a 270 deg 30 m laser (its log is
 #     about 130 MB per seed).
@@ -106,10 +108,12 @@ if "out_of_map_updates" in pools:
     kinds.append(("out_of_map_updates", pools["out_of_map_updates"]))
 refusals = str(sum(n for _, n in kinds)) if st else "NA"
 nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
+rpe = (ev or {}).get("rpe") or {}
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
-                 get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d]))
+                 get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
+                 get(rpe, "mean_m"), get(rpe, "scale_error")]))
 EOF
-  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\n' \
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\n' \
     "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
   mv "$dir/record.tsv.tmp" "$dir/record.tsv"
   value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
@@ -180,11 +184,11 @@ xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job 
 
 # runs.tsv in job order; a job that left no record counts as failed.
 runs="$out/runs.tsv"
-printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\n' > "$runs"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\n' > "$runs"
 while read -r kind name seed; do
   rec="$out/${kind}s/$name/$seed/record.tsv"
   if [ -f "$rec" ]; then cat "$rec"; else
-    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\n' "$kind" "$name" "$seed" "${rec%/*}"
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
   fi
 done < "$joblist" >> "$runs"
 
@@ -201,9 +205,9 @@ def fmt(v, f):
     return "NA" if v is None else f % v
 def nums(rs, k):
     return [x for x in (num(r[k]) for r in rs) if x is not None]
-out = ["| name | metric | mean | worst (seed) | per seed | CPU s mean | CPU s max | worst scan ms "
-       "| state bytes | peak RSS MiB | refusals |",
-       "|---|---|---|---|---|---|---|---|---|---|---|"]
+out = ["| name | metric | mean | worst (seed) | per seed | drift m per 10 m, mean (worst) | along-track % "
+       "| CPU s mean | CPU s max | worst scan ms | state bytes | peak RSS MiB | refusals |",
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for (kind, name), rs in groups.items():
     metric = "relations m" if kind == "log" else "ATE m"
     ok = [(num(r["value_m"]), r["seed"]) for r in rs if num(r["value_m"]) is not None]
@@ -215,7 +219,11 @@ for (kind, name), rs in groups.items():
     scan, arena, rss, ref = (nums(rs, k) for k in ("scan_cpu_ms_max", "arena_bytes", "peak_rss_kib", "refusals"))
     kinds = sorted({k.split("=")[0] for r in rs if r["refusal_kinds"] != "-" for k in r["refusal_kinds"].split(",")})
     refs = "NA" if not ref else "%d" % sum(ref) + (" (%s)" % ", ".join(kinds) if kinds else "")
-    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per,
+    # The relative error needs a ground-truth trajectory: the worlds have one, the logs not.
+    rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
+    drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
+    along = "-" if not scale else "%+.2f" % (100.0 * sum(scale) / len(scale))
+    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, drift, along,
         fmt(sum(cpu) / len(cpu) if cpu else None, "%.1f"), fmt(max(cpu) if cpu else None, "%.1f"),
         fmt(max(scan) if scan else None, "%.1f"), fmt(max(arena) if arena else None, "%d"),
         fmt(max(rss) / 1024 if rss else None, "%.1f"), refs]))
