@@ -44,19 +44,11 @@ bool compute_ate(const std::vector<io::StampedPose>& estimate, const std::vector
   AteResult r;
   r.estimate_count = estimate.size();
   r.ground_truth_count = ground_truth.size();
-  std::vector<io::StampedPose> gt = ground_truth;
-  std::stable_sort(gt.begin(), gt.end(),
-                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
   std::vector<Pose2> est_pts;
   std::vector<Pose2> gt_pts;
-  for (const io::StampedPose& e : estimate) {
-    std::size_t k = 0;
-    if (find_stamp(gt, e.stamp_us, tolerance_us, &k) == StampMatch::kNone) {
-      ++r.unmatched_estimate_count;
-      continue;
-    }
-    est_pts.push_back(e.pose);
-    gt_pts.push_back(gt[k].pose);
+  for (const PosePair& p : pair_by_stamp(estimate, ground_truth, tolerance_us, &r.unmatched_estimate_count)) {
+    est_pts.push_back(p.estimate);
+    gt_pts.push_back(p.truth);
   }
   r.matched_count = est_pts.size();
   if (est_pts.empty()) {

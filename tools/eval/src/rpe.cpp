@@ -7,31 +7,14 @@
 #include "sdpslam/eval/stamp_match.h"
 
 namespace sdpslam::eval {
-namespace {
-
-struct Pair {
-  std::int64_t stamp_us;
-  Pose2 est;
-  Pose2 gt;
-};
-
-}  // namespace
 
 bool compute_rpe(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& ground_truth,
                  std::int64_t tolerance_us, double distance_m, RpeResult* result) {
   RpeResult r;
   r.distance_m = distance_m;
-  std::vector<io::StampedPose> gt = ground_truth;
-  std::stable_sort(gt.begin(), gt.end(),
-                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
-  std::vector<Pair> pairs;
-  pairs.reserve(estimate.size());
-  for (const io::StampedPose& e : estimate) {
-    std::size_t k = 0;
-    if (find_stamp(gt, e.stamp_us, tolerance_us, &k) == StampMatch::kNone) continue;
-    pairs.push_back({e.stamp_us, e.pose, gt[k].pose});
-  }
-  std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.stamp_us < y.stamp_us; });
+  std::vector<PosePair> pairs = pair_by_stamp(estimate, ground_truth, tolerance_us, nullptr);
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const PosePair& x, const PosePair& y) { return x.stamp_us < y.stamp_us; });
   r.matched_count = pairs.size();
   if (!(distance_m > 0.0) || pairs.size() < 2) {
     *result = r;
@@ -40,7 +23,7 @@ bool compute_rpe(const std::vector<io::StampedPose>& estimate, const std::vector
   // Ground-truth path length from the first pair to each pair.
   std::vector<double> travel(pairs.size(), 0.0);
   for (std::size_t k = 1; k < pairs.size(); ++k) {
-    travel[k] = travel[k - 1] + std::hypot(pairs[k].gt.x_m - pairs[k - 1].gt.x_m, pairs[k].gt.y_m - pairs[k - 1].gt.y_m);
+    travel[k] = travel[k - 1] + std::hypot(pairs[k].truth.x_m - pairs[k - 1].truth.x_m, pairs[k].truth.y_m - pairs[k - 1].truth.y_m);
   }
   double sum = 0.0, sum_sq = 0.0, sum_heading = 0.0, sum_scale = 0.0;
   std::size_t scaled = 0;
@@ -49,8 +32,8 @@ bool compute_rpe(const std::vector<io::StampedPose>& estimate, const std::vector
     if (j <= i) j = i + 1;
     while (j < pairs.size() && travel[j] - travel[i] < distance_m) ++j;
     if (j >= pairs.size()) break;  // every later start is shorter still
-    const Pose2 de = between(pairs[i].est, pairs[j].est);
-    const Pose2 dg = between(pairs[i].gt, pairs[j].gt);
+    const Pose2 de = between(pairs[i].estimate, pairs[j].estimate);
+    const Pose2 dg = between(pairs[i].truth, pairs[j].truth);
     const double ex = de.x_m - dg.x_m;
     const double ey = de.y_m - dg.y_m;
     const double e = std::hypot(ex, ey);

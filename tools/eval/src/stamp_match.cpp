@@ -4,6 +4,27 @@
 
 namespace sdpslam::eval {
 
+std::vector<PosePair> pair_by_stamp(const std::vector<io::StampedPose>& estimate,
+                                    const std::vector<io::StampedPose>& ground_truth, std::int64_t tolerance_us,
+                                    std::size_t* unmatched) {
+  std::vector<io::StampedPose> gt = ground_truth;
+  std::stable_sort(gt.begin(), gt.end(),
+                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
+  std::vector<PosePair> pairs;
+  pairs.reserve(estimate.size());
+  std::size_t missed = 0;
+  for (const io::StampedPose& e : estimate) {
+    std::size_t k = 0;
+    if (find_stamp(gt, e.stamp_us, tolerance_us, &k) == StampMatch::kNone) {
+      ++missed;
+      continue;
+    }
+    pairs.push_back({e.stamp_us, e.pose, gt[k].pose});
+  }
+  if (unmatched != nullptr) *unmatched = missed;
+  return pairs;
+}
+
 StampMatch find_stamp(const std::vector<io::StampedPose>& sorted, std::int64_t stamp_us, std::int64_t tolerance_us,
                       std::size_t* index) {
   const auto it = std::lower_bound(sorted.begin(), sorted.end(), stamp_us,

@@ -209,8 +209,9 @@ class AncestryTree {
   // drain, possibly after a merge carried it into a child. The same holds for the only
   // root of the tree when it is an active leaf: one particle (or all of them, on one
   // node) whose lineage never branched, e.g. a one-particle filter, which never
-  // resamples. Other roots with fewer than two children keep theirs. Emitted poses followed by for_each_pose_from_root(leaf) reproduce the
-  // leaf's full trajectory exactly. Returns the number of poses emitted. O(emitted).
+  // resamples. Other roots with fewer than two children keep theirs. Emitted poses
+  // followed by for_each_pose_from_root(leaf) reproduce the leaf's full trajectory
+  // exactly. Returns the number of poses emitted. O(emitted).
   std::uint32_t drain_committed(PoseSink& sink);
 
   // ---- accounting --------------------------------------------------------------------

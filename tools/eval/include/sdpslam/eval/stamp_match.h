@@ -1,5 +1,6 @@
 #pragma once
 // Matching of timestamps between files that should carry the same laser stamps.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,20 @@ enum class StampMatch { kExact, kNearest, kNone };
 // kNone (index untouched) when there is none. O(log n).
 StampMatch find_stamp(const std::vector<io::StampedPose>& sorted, std::int64_t stamp_us, std::int64_t tolerance_us,
                       std::size_t* index);
+
+// An estimated pose and the ground-truth pose of the same stamp.
+struct PosePair {
+  std::int64_t stamp_us = 0;
+  Pose2 estimate;
+  Pose2 truth;
+};
+
+// Every estimate paired with the ground-truth pose find_stamp() gives for its stamp
+// (`ground_truth` need not be sorted), in the estimate's order; `*unmatched` (may be
+// null) counts the estimates left without one. O((n + m) log m).
+std::vector<PosePair> pair_by_stamp(const std::vector<io::StampedPose>& estimate,
+                                    const std::vector<io::StampedPose>& ground_truth, std::int64_t tolerance_us,
+                                    std::size_t* unmatched);
 
 // True iff stamps are strictly increasing; otherwise `*bad_index` is the first pose whose
 // stamp is not greater than its predecessor's.
