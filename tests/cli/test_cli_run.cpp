@@ -1,6 +1,7 @@
 // `sdpslam run` end to end on small logs with bad lines: every skipped line is named
 // with file:line and its reason (the first kLogErrorsShown of each kind), the rest are
-// counted, and the good scans still make a trajectory.
+// counted, and the good scans still make a trajectory. Option values out of range are
+// usage errors, not silently wrapped or saturated.
 #include <CppUTest/TestHarness.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -291,4 +292,41 @@ TEST(CliRun, top_level_options_in_dpslam_mode_are_not_ignored_silently) {
   r = run_cli("run " + log + " --mode dpslam --config " + ini + " --out " + dir + "/b");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   STRCMP_CONTAINS((ini + ": [sdp] keys have no effect in --mode dpslam").c_str(), r.out.c_str());
+}
+
+TEST(CliRun, numbers_out_of_range_and_an_empty_output_folder_are_usage_errors) {
+  const std::string log = log_with_bad_lines(0);
+  const struct {
+    const char* args;
+    const char* why;
+  } refused[] = {
+      {"--seed -1", "--seed: must be a whole number from 0 to 18446744073709551615, not '-1'"},
+      {"--seed 18446744073709551616", "not '18446744073709551616'"},
+      {"--seed 99999999999999999999999", "not '99999999999999999999999'"},
+      {"--seed 7x", "not '7x'"},
+      {"--particles -3", "--particles: must be a whole number from 0 to 4294967295, not '-3'"},
+      {"--top-particles 4294967296", "--top-particles: must be a whole number from 0 to 4294967295"},
+  };
+  for (const auto& c : refused) {
+    const Run r = run_cli("run " + log + " " + c.args + " --out " + dir + "/a");
+    LONGS_EQUAL_TEXT(2, r.status, c.args);
+    STRCMP_CONTAINS(c.why, r.out.c_str());
+  }
+  struct stat st {};
+  CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));  // nothing ran
+  Run r = run_cli("run " + log + " --out ''");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--out: must not be empty", r.out.c_str());
+  // The largest seed is a seed like any other.
+  r = run_cli("run " + log + " --seed 18446744073709551615 --out " + dir + "/b");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  r = run_cli("simulate --world paper --seed -1 --out " + dir + "/c");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--seed: must be a whole number", r.out.c_str());
+  r = run_cli("simulate --world paper --odom-rate -5 --out " + dir + "/c");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--odom-rate: must be a whole number", r.out.c_str());
+  r = run_cli("simulate --world paper --out ''");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--out: must not be empty", r.out.c_str());
 }

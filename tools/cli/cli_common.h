@@ -20,6 +20,14 @@ enum ExitCode : int {
   kExitIo = 4,         // an output could not be written
 };
 
+// Checks for option values CLI11 would take wrongly without a word: it reads "-1" into
+// an unsigned option as the type's largest value (two's complement) and a number beyond
+// the type's range as that largest value too. whole_number(max) accepts decimal
+// digits only, at most `max`; non_empty() refuses "" (an empty --out is a usage error,
+// not a failed write). A refused value exits kExitUsage with the option's name.
+CLI::Validator whole_number(std::uint64_t max);
+CLI::Validator non_empty();
+
 // Size of a file in KiB (0 when it cannot be read), a progress total.
 std::uint64_t file_size_kib(const std::string& path);
 

@@ -5,6 +5,7 @@
 // (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
 // dpslam: the bottom-level DP-SLAM filter alone, the baseline (tools/slam/run_offline.h).
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -161,8 +162,10 @@ std::function<int()> setup_run(CLI::App& app) {
       ->check(CLI::IsMember({"sdp", "dpslam"}))
       ->capture_default_str();
   app.add_option("--particles", args->particles,
-                 "Bottom-level particles, over [filter] particles (default: sdp 10, dpslam 30)");
-  app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)");
+                 "Bottom-level particles, over [filter] particles (default: sdp 10, dpslam 30)")
+      ->check(whole_number(UINT32_MAX));
+  app.add_option("--top-particles", args->top_particles, "sdp: top-level particles (default 60, [sdp] top_particles)")
+      ->check(whole_number(UINT32_MAX));
   app.add_option("--topology", args->topology, "sdp: topology estimation, sdp (default) or segslam (local analysis)")
       ->check(CLI::IsMember({"sdp", "segslam"}));
   app.add_option("--profile", args->profile,
@@ -171,8 +174,8 @@ std::function<int()> setup_run(CLI::App& app) {
       ->check(CLI::IsMember({"accurate", "paper"}));
   app.add_option("--config", args->config,
                  "INI options on top of the profile: bottom level and [sdp] (see tools/slam/default.ini)");
-  app.add_option("--seed", args->seed, "Random seed (same seed, same output)");
-  app.add_option("--out", args->out, "Output directory")->required();
+  app.add_option("--seed", args->seed, "Random seed (same seed, same output)")->check(whole_number(UINT64_MAX));
+  app.add_option("--out", args->out, "Output directory")->required()->check(non_empty());
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";

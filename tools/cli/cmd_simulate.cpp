@@ -17,9 +17,11 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cli_common.h"
@@ -136,6 +138,10 @@ template <typename Field>
 void add_sim_option(CLI::App& app, SimulateArgs* args, const std::string& name, Field field,
                     const std::string& help) {
   CLI::Option* option = app.add_option(name, field(args->options), help)->capture_default_str();
+  using Value = std::remove_reference_t<decltype(field(args->options))>;
+  if constexpr (std::is_integral_v<Value> && std::is_unsigned_v<Value>) {
+    option->check(whole_number(std::numeric_limits<Value>::max()));
+  }
   args->keep_given.push_back([option, field](const sim::SimulationOptions& given, sim::SimulationOptions* out) {
     if (option->count() > 0) field(*out) = field(given);
   });
@@ -168,7 +174,7 @@ std::function<int()> setup_simulate(CLI::App& app) {
   app.add_option("--route", args->route_path,
                  "route file: one waypoint 'x y' per line (default: the built-in world's)");
   add_sim_option(app, a, "--seed", [](auto& o) -> auto& { return o.seed; }, "random seed");
-  app.add_option("--out", args->out_dir, "output directory")->capture_default_str();
+  app.add_option("--out", args->out_dir, "output directory")->capture_default_str()->check(non_empty());
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   add_sim_option(app, a, "--speed", [](auto& o) -> auto& { return o.robot.max_speed_mps; }, "top speed, m/s");
   add_sim_option(app, a, "--accel", [](auto& o) -> auto& { return o.robot.max_accel_mps2; },

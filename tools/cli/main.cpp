@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 #include <vector>
 
 #include "cli_common.h"
@@ -22,6 +23,29 @@ std::vector<CommandInfo>& registry() {
 bool register_command(const CommandInfo& info) {
   registry().push_back(info);
   return true;
+}
+
+CLI::Validator whole_number(std::uint64_t max) {
+  const std::string limit = std::to_string(max);
+  return CLI::Validator(
+      [max, limit](std::string& text) -> std::string {
+        const std::string why = "must be a whole number from 0 to " + limit + ", not '" + text + "'";
+        if (text.empty() || text.size() > 20U) return why;
+        std::uint64_t value = 0U;
+        for (const char c : text) {
+          if (c < '0' || c > '9') return why;
+          const auto digit = static_cast<std::uint64_t>(c - '0');
+          if (value > (max - digit) / 10U) return why;  // value * 10 + digit > max
+          value = value * 10U + digit;
+        }
+        return std::string();
+      },
+      "0.." + limit);
+}
+
+CLI::Validator non_empty() {
+  return CLI::Validator([](std::string& text) { return text.empty() ? std::string("must not be empty") : std::string(); },
+                        "NONEMPTY");
 }
 
 std::uint64_t file_size_kib(const std::string& path) {
