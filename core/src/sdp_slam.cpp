@@ -502,6 +502,8 @@ void SdpSlam::make_oldest_permanent() {
   pm.from_previous = had_anchor ? between(previous_frame, r.frame_in_global) : Pose2{};
   for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
   pm.level = level;
+  pm.start_stamp_us = levels_[slot(level)].start_stamp_us;
+  pm.initial = sm.initial;
   pm.point_count = sm.point_count;
   pm.obstacle_count = 0U;
   if (options_.loop_closure) {
@@ -1108,6 +1110,20 @@ bool SdpSlam::permanent_slot(std::uint32_t level, std::uint32_t* pi) const {
 // submaps of a level share the level's frame (the bottom particles restarted at one
 // pose in the map's grid frame), so a constraint between two levels' frames measured
 // with some of their submaps holds for the chosen ones too.
+bool SdpSlam::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const {
+  std::uint32_t pi = 0U;
+  if (permanent_slot(level, &pi)) {
+    *stamp_us = perm_[pi].start_stamp_us;
+    *initial = perm_[pi].initial;
+    return true;
+  }
+  const std::uint32_t first = graph_.first_live_level();
+  if (level < first || level >= first + graph_.live_level_count() || levels_[slot(level)].count == 0U) return false;
+  *stamp_us = levels_[slot(level)].start_stamp_us;
+  *initial = submap(level, 0U).initial;
+  return true;
+}
+
 bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
   std::uint32_t pi = 0U;
   if (permanent_slot(level, &pi)) {

@@ -330,3 +330,29 @@ TEST(CliRun, numbers_out_of_range_and_an_empty_output_folder_are_usage_errors) {
   LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
   STRCMP_CONTAINS("--out: must not be empty", r.out.c_str());
 }
+
+// loops.tsv names each loop constraint's levels with where they started, so that a
+// simulated run's constraints can be checked against its ground truth: on the paper
+// world every constraint the run used is right (within 0.5 m), which it can only be if
+// the origins are the levels' true ones.
+TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
+  Run r = run_cli("simulate --world paper --seed 4 --quiet --out " + dir + "/sim");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  r = run_cli("run " + dir + "/sim/sim.clf --seed 4 --quiet --out " + dir + "/run");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  std::ifstream manifest(dir + "/run/manifest.txt");
+  std::stringstream m;
+  m << manifest.rdbuf();
+  STRCMP_CONTAINS(" loops.tsv\n", m.str().c_str());
+  CHECK_TRUE(lines_in(dir + "/run/loops.tsv") >= 2U);
+  r = run_cli("evaluate --loops " + dir + "/run/loops.tsv --ground-truth " + dir + "/sim/ground_truth.txt --json " +
+              dir + "/loops.json");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS(" 0 without a ground-truth origin", r.out.c_str());
+  std::ifstream json_file(dir + "/loops.json");
+  std::stringstream json;
+  json << json_file.rdbuf();
+  const std::string used = json.str().substr(json.str().find("\"used\""));
+  STRCMP_CONTAINS("\"between\": 0, \"wrong\": 0", used.c_str());
+  CHECK_TEXT(used.find("\"count\": 0,") == std::string::npos, used.c_str());
+}

@@ -1,5 +1,5 @@
-// `sdpslam evaluate` end to end: figures on a tiny synthetic log, JSON output, and exit
-// codes with file:line for bad input.
+// `sdpslam evaluate` end to end: figures on a tiny synthetic log, loop constraints
+// against a ground truth, JSON output, and exit codes with file:line for bad input.
 #include <CppUTest/TestHarness.h>
 #include <unistd.h>
 
@@ -34,7 +34,8 @@ TEST_GROUP(CliEvaluate) {
   std::string dir;
   void setup() override { dir = sdpslam::test::make_temp_dir("cli-eval"); }
   void teardown() override {
-    for (const char* f : {"/log.clf", "/r.relations", "/t.txt", "/gt.txt", "/bad.txt", "/out.json", "/m.pgm", "/m.yaml"}) {
+    for (const char* f : {"/log.clf", "/r.relations", "/t.txt", "/gt.txt", "/bad.txt", "/out.json", "/m.pgm", "/m.yaml",
+                          "/l.tsv"}) {
       ::unlink((dir + f).c_str());
     }
     ::rmdir(dir.c_str());
@@ -198,4 +199,32 @@ TEST(CliEvaluate, map_agreement_needs_a_trajectory_and_a_readable_map) {
   r = run_evaluate("--log " + log() + " --trajectory " + t + " --map " + dir + "/none.yaml");
   LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
   STRCMP_CONTAINS("none.yaml: cannot open", r.out.c_str());
+}
+
+TEST(CliEvaluate, loop_constraints_are_checked_against_the_ground_truth) {
+  const std::string gt = put("gt.txt", "1 0 0 0\n2 4 0 0\n3 4 4 1.5707963267948966\n4 0 4 3.141592653589793\n");
+  // Frames at the robot's start poses: the true loop 1 -> 4 is the pose of 4 in 1; the
+  // second says 3 m more along x (a corridor one door along).
+  const std::string loops =
+      put("l.tsv",
+          "# older newer source used error_m z_x z_y z_theta older_stamp ... newer_stamp ...\n"
+          "0 3 search 1 0.05 0 4 3.141592653589793 1.000000 0 0 0 4.000000 0 0 0\n"
+          "0 3 icp 1 0.05 3 4 3.141592653589793 1.000000 0 0 0 4.000000 0 0 0\n"
+          "1 2 icp 0 0.05 0 4 1.5707963267948966 2.000000 0 0 0 - 0 0 0\n");
+  Run r = run_evaluate("--loops " + loops + " --ground-truth " + gt + " --json " + dir + "/out.json");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS(("3 in " + loops + ", 1 without a ground-truth origin").c_str(), r.out.c_str());
+  STRCMP_CONTAINS("search      1: right 1, between 0, wrong 0", r.out.c_str());
+  STRCMP_CONTAINS("icp         1: right 0, between 0, wrong 1, largest error 3.000 m", r.out.c_str());
+  STRCMP_CONTAINS("used        2: right 1, between 0, wrong 1", r.out.c_str());
+  const std::string json = slurp(dir + "/out.json");
+  STRCMP_CONTAINS("\"loops\": {\"file\": ", json.c_str());
+  STRCMP_CONTAINS("\"icp\": {\"count\": 1, \"right\": 0, \"between\": 0, \"wrong\": 1, \"max_m\": 3", json.c_str());
+  r = run_evaluate("--loops " + loops);
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--loops needs --ground-truth", r.out.c_str());
+  const std::string bad = put("bad.txt", "0 3 search 1 0.05 0 4\n");
+  r = run_evaluate("--loops " + bad + " --ground-truth " + gt);
+  LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
+  STRCMP_CONTAINS((bad + ":1: expected").c_str(), r.out.c_str());
 }

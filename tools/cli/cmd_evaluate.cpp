@@ -10,6 +10,11 @@
 //       absolute trajectory error after the best SE(2) alignment, and the relative
 //       error over every D metres of the ground-truth path (default 10; 0 = not measured):
 //       the local drift, with the along-track scale error (tools/eval/include/sdpslam/eval/rpe.h).
+//   sdpslam evaluate --loops LOOPS.tsv --ground-truth GT
+//       the loop constraints a run held (its loops.tsv) checked against the ground truth:
+//       how many were right (< 0.5 m), wrong (>= 2 m) or between, per source (the wide
+//       search, the top level's ICP) and among those used at the end
+//       (tools/eval/include/sdpslam/eval/loops.h).
 //   sdpslam evaluate --log LOG --trajectory TRAJ --map MAP.yaml
 //       agreement of the map with the trajectory: the share of the log's laser returns,
 //       cast from the trajectory's poses, that end within one cell of an occupied cell
@@ -28,6 +33,7 @@
 #include "cli_common.h"
 #include "sdpslam/eval/ate.h"
 #include "sdpslam/eval/log_scans.h"
+#include "sdpslam/eval/loops.h"
 #include "sdpslam/eval/map_agreement.h"
 #include "sdpslam/eval/relations.h"
 #include "sdpslam/eval/rpe.h"
@@ -46,6 +52,7 @@ struct EvaluateArgs {
   std::string trajectory_path;
   std::string ground_truth_path;
   std::string map_path;
+  std::string loops_path;
   std::string json_path;
   bool odometry = false;
   double rpe_m = 10.0;
@@ -255,6 +262,39 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
   return kExitOk;
 }
 
+std::string json_bins(const eval::LoopBins& b) {
+  return "{\"count\": " + std::to_string(b.count) + ", \"right\": " + std::to_string(b.right) +
+         ", \"between\": " + std::to_string(b.between) + ", \"wrong\": " + std::to_string(b.wrong) +
+         ", \"max_m\": " + json_number(b.max_m) + "}";
+}
+
+int run_loops(const EvaluateArgs& a, std::string* json) {
+  std::vector<eval::LoopLine> lines;
+  std::string error;
+  if (!eval::read_loops(a.loops_path, &lines, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  std::vector<io::StampedPose> truth;
+  if (const int rc = read_trajectory_file(a.ground_truth_path, &truth); rc != kExitOk) return rc;
+  const eval::LoopsResult r = eval::check_loops(lines, truth, a.tolerance_us);
+  auto row = [](const char* what, const eval::LoopBins& b) {
+    std::printf("  %-10s  %zu: right %zu, between %zu, wrong %zu, largest error %.3f m\n", what, b.count, b.right,
+                b.between, b.wrong, b.max_m);
+  };
+  std::printf("Loop constraints against the ground truth (right: within %.1f m, wrong: %.1f m or more)\n",
+              eval::kLoopRightM, eval::kLoopWrongM);
+  std::printf("  loops       %zu in %s, %zu without a ground-truth origin\n", r.count, a.loops_path.c_str(),
+              r.unmatched);
+  row("search", r.search);
+  row("icp", r.icp);
+  row("used", r.used);
+  *json += "\"loops\": {\"file\": " + json_string(a.loops_path) + ", \"count\": " + std::to_string(r.count) +
+           ", \"unmatched\": " + std::to_string(r.unmatched) + ", \"search\": " + json_bins(r.search) +
+           ", \"icp\": " + json_bins(r.icp) + ", \"used\": " + json_bins(r.used) + "}";
+  return kExitOk;
+}
+
 int run_map_agreement(const EvaluateArgs& a, std::string* json) {
   std::vector<io::StampedPose> estimate;
   if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
@@ -293,10 +333,15 @@ int run_evaluate(const EvaluateArgs& a) {
   const bool want_relations = !a.relations_path.empty();
   const bool want_ate = !a.ground_truth_path.empty();
   const bool want_map = !a.map_path.empty();
-  if (!want_relations && !want_ate && !want_map) {
+  const bool want_loops = !a.loops_path.empty();
+  if (!want_relations && !want_ate && !want_map && !want_loops) {
     std::fprintf(stderr,
-                 "sdpslam evaluate: give --relations (with --log), --ground-truth (with --trajectory) or --map (with "
-                 "--log and --trajectory)\n");
+                 "sdpslam evaluate: give --relations (with --log), --ground-truth (with --trajectory), --loops (with "
+                 "--ground-truth) or --map (with --log and --trajectory)\n");
+    return kExitUsage;
+  }
+  if (want_loops && a.ground_truth_path.empty()) {
+    std::fprintf(stderr, "sdpslam evaluate: --loops needs --ground-truth\n");
     return kExitUsage;
   }
   if (want_map && (a.log_path.empty() || a.trajectory_path.empty())) {
@@ -307,7 +352,7 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --relations needs --log and exactly one of --trajectory, --odometry\n");
     return kExitUsage;
   }
-  if (want_ate && a.trajectory_path.empty()) {
+  if (want_ate && a.trajectory_path.empty() && !want_loops) {
     std::fprintf(stderr, "sdpslam evaluate: --ground-truth needs --trajectory\n");
     return kExitUsage;
   }
@@ -323,15 +368,22 @@ int run_evaluate(const EvaluateArgs& a) {
   if (want_relations) {
     if (const int rc = run_relations(a, &json); rc != kExitOk) return rc;
   }
-  if (want_ate) {
+  if (want_ate && !a.trajectory_path.empty()) {
     if (want_relations) {
       json += ", ";
       std::printf("\n");
     }
     if (const int rc = run_ate(a, &json); rc != kExitOk) return rc;
   }
+  if (want_loops) {
+    if (json.size() > 1U) {
+      json += ", ";
+      std::printf("\n");
+    }
+    if (const int rc = run_loops(a, &json); rc != kExitOk) return rc;
+  }
   if (want_map) {
-    if (want_relations || want_ate) {
+    if (json.size() > 1U) {
       json += ", ";
       std::printf("\n");
     }
@@ -360,6 +412,8 @@ std::function<int()> setup_evaluate(CLI::App& app) {
                  "with --ground-truth: also the relative error over every stretch of this many metres (default 10, "
                  "0 = not measured)");
   app.add_option("--map", args->map_path, "map (map_server YAML + PGM) whose agreement with --trajectory to measure");
+  app.add_option("--loops", args->loops_path,
+                 "with --ground-truth: check the loop constraints of a run (its loops.tsv) against it");
   app.add_option("--json", args->json_path, "also write the figures to this JSON file");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
                  "stamps closer than this name the same scan when not equal (default 1000)");

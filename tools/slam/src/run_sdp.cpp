@@ -376,6 +376,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     csv += line;
   }
   if (!io::write_file_atomic(outputs.path("icp_error.csv"), csv, error)) return SdpRunStatus::kIoError;
+  if (!io::write_file_atomic(outputs.path("loops.tsv"), sdp_loops_tsv(*slam), error)) return SdpRunStatus::kIoError;
   if (!write_error_plot(outputs.path("icp_error.png"), rows.rows, scans.front().stamp_us, scans.back().stamp_us, error)) {
     return SdpRunStatus::kIoError;
   }

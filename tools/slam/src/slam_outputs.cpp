@@ -210,6 +210,31 @@ std::string filter_pools_json(const DpSlamFilter& filter) {
   return js;
 }
 
+std::string sdp_loops_tsv(const SdpSlam& slam) {
+  std::string out =
+      "# sdpslam loop constraints: older newer source used error_m z_x z_y z_theta older_stamp older_x older_y "
+      "older_theta newer_stamp newer_x newer_y newer_theta (s, m, rad)\n";
+  const LoopClosure& loops = slam.loop_closure();
+  auto origin = [&slam](std::uint32_t level) {
+    std::int64_t stamp_us = 0;
+    Pose2 p;
+    if (!slam.level_origin(level, &stamp_us, &p)) return std::string("- 0 0 0");
+    char text[160];
+    std::snprintf(text, sizeof text, "%s %.6f %.6f %.9f", io::format_stamp_us(stamp_us).c_str(), p.x_m, p.y_m,
+                  p.heading_rad);
+    return std::string(text);
+  };
+  for (std::uint32_t k = 0; k < loops.record_count(); ++k) {
+    const LoopClosure::Record& r = loops.record(k);
+    const bool used = slam.level_held(r.older_level) && slam.level_held(r.newer_level);
+    char line[200];
+    std::snprintf(line, sizeof line, "%u %u %s %d %.6f %.6f %.6f %.9f ", r.older_level, r.newer_level,
+                  r.searched ? "search" : "icp", used ? 1 : 0, r.error_m, r.z.x_m, r.z.y_m, r.z.heading_rad);
+    out += line + origin(r.older_level) + " " + origin(r.newer_level) + "\n";
+  }
+  return out;
+}
+
 std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
                            std::uint64_t path_gaps, std::uint32_t known_cells) {
   const DpSlamFilter& bottom = slam.bottom();

@@ -221,6 +221,20 @@ class SdpSlam {
   const SegmentGraph& graph() const { return graph_; }
   const SdpOptions& options() const { return options_; }
   const SdpStats& stats() const { return stats_; }
+
+  // ---- loop closure, for inspection (loop_closure.h) ----------------------------------
+  // The loop constraints held now: each joins the frames of two levels. level_origin()
+  // says where a level started: the stamp of the scan its segment restarted at (the
+  // previous segment's last) and the restart pose in the level's frame, so that with a
+  // ground truth GT the level's frame is GT(stamp) ⊕ initial⁻¹ and a constraint can be
+  // checked. False for a level not held (forgotten, or not made yet). level_held(): the
+  // level's frame is in the pose graph (a loop between two held levels is used).
+  const LoopClosure& loop_closure() const { return loop_closure_; }
+  bool level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const;
+  bool level_held(std::uint32_t level) const {
+    std::uint32_t index = 0U;
+    return graph_index(level, &index);
+  }
   std::uint32_t permanent_submap_count() const { return perm_count_; }
   std::uint32_t pose_ring_capacity() const { return ring_capacity_; }
   std::size_t arena_bytes_used() const { return arena_used_; }
@@ -259,6 +273,8 @@ class SdpSlam {
     std::uint32_t level = 0U;
     std::uint32_t point_count = 0U;
     std::uint32_t obstacle_count = 0U;
+    std::int64_t start_stamp_us = 0;  // level_origin()
+    Pose2 initial;
   };
   // An obstacle point in half DP-map cells from the map's origin (the submap frame is the
   // map's grid frame).

@@ -92,6 +92,16 @@ class SdpPermanentPath final : public SdpPathSink {
 // particle (SdpSlam::for_each_best_pose).
 std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermanentPath& permanent);
 
+// loops.tsv: the loop constraints SDP-SLAM holds at the end of a run, one per line (in
+// the store's order), with the origin of both levels (SdpSlam::level_origin), so that a
+// ground truth can say which constraints were right (`sdpslam evaluate --loops`):
+//   older newer source used error_m z_x z_y z_theta
+//     older_stamp older_x older_y older_theta newer_stamp newer_x newer_y newer_theta
+// source: search (the wide loop search) or icp (the top level's ICP); used: 1 when both
+// levels are in the pose graph. Stamps in seconds (six decimals), poses in m and rad; a
+// level whose origin is no longer held has stamp "-" and zero pose.
+std::string sdp_loops_tsv(const SdpSlam& slam);
+
 // The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map (each cell
 // moved with its level's frame as loop closure corrected it) plus
 // each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
