@@ -8,7 +8,9 @@
 #     noise, so each seed is a different simulated run), `sdpslam run --seed S` on it, then
 #     the absolute trajectory error against the simulator's ground truth (ATE RMSE after
 #     SE(2) alignment, m) and the relative error per 10 m of path (`sdpslam evaluate`'s
-#     --rpe-m: the local drift, and its along-track part, whatever the loops did).
+#     --rpe-m: the local drift, and its along-track part, whatever the loops did), and
+#     the loop constraints the run used, checked against that ground truth (`evaluate
+#     --loops`: "wrong loops used" counts those 2 m or more off, over all seeds).
 #     `simulate` has two built-in worlds: "paper", the paper's nested
 #     28 m / 80 m loops, and "large", a 203 m x 123 m building with 2.26 km of nested loops,
 #     an open hall and featureless corridors, scanned by a 270 deg 30 m laser (its log is
@@ -72,6 +74,8 @@ if [ "${1:-}" = --job ]; then
       set -- --log "$log" --relations "$ACC_SHARED/datasets/$name.relations"
     else
       set -- --ground-truth "$dir/sim/ground_truth.txt"
+      # sdp mode writes its loop constraints: checked against the ground truth too.
+      if [ -f "$dir/loops.tsv" ]; then set -- "$@" --loops "$dir/loops.tsv"; fi
     fi
     if "$bin" evaluate "$@" --trajectory "$dir/trajectory.txt" --json "$dir/evaluate.json" \
          > "$dir/evaluate.txt" 2>&1; then :; else
@@ -109,11 +113,12 @@ if "out_of_map_updates" in pools:
 refusals = str(sum(n for _, n in kinds)) if st else "NA"
 nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
 rpe = (ev or {}).get("rpe") or {}
+used = ((ev or {}).get("loops") or {}).get("used") or {}
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
                  get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
-                 get(rpe, "mean_m"), get(rpe, "scale_error")]))
+                 get(rpe, "mean_m"), get(rpe, "scale_error"), get(used, "count"), get(used, "wrong")]))
 EOF
-  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\n' \
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\n' \
     "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
   mv "$dir/record.tsv.tmp" "$dir/record.tsv"
   value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
@@ -184,11 +189,11 @@ xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job 
 
 # runs.tsv in job order; a job that left no record counts as failed.
 runs="$out/runs.tsv"
-printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\n' > "$runs"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\n' > "$runs"
 while read -r kind name seed; do
   rec="$out/${kind}s/$name/$seed/record.tsv"
   if [ -f "$rec" ]; then cat "$rec"; else
-    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
   fi
 done < "$joblist" >> "$runs"
 
@@ -206,8 +211,8 @@ def fmt(v, f):
 def nums(rs, k):
     return [x for x in (num(r[k]) for r in rs) if x is not None]
 out = ["| name | metric | mean | worst (seed) | per seed | drift m per 10 m, mean (worst) | along-track % "
-       "| CPU s mean | CPU s max | worst scan ms | state bytes | peak RSS MiB | refusals |",
-       "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+       "| wrong loops used | CPU s mean | CPU s max | worst scan ms | state bytes | peak RSS MiB | refusals |",
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for (kind, name), rs in groups.items():
     metric = "relations m" if kind == "log" else "ATE m"
     ok = [(num(r["value_m"]), r["seed"]) for r in rs if num(r["value_m"]) is not None]
@@ -223,7 +228,10 @@ for (kind, name), rs in groups.items():
     rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
     drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
     along = "-" if not scale else "%+.2f" % (100.0 * sum(scale) / len(scale))
-    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, drift, along,
+    # Loop constraints used at the end that the ground truth says are 2 m or more off.
+    used, wrong = nums(rs, "loops_used"), nums(rs, "loops_used_wrong")
+    loops = "-" if not used else "%d of %d" % (sum(wrong), sum(used))
+    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, drift, along, loops,
         fmt(sum(cpu) / len(cpu) if cpu else None, "%.1f"), fmt(max(cpu) if cpu else None, "%.1f"),
         fmt(max(scan) if scan else None, "%.1f"), fmt(max(arena) if arena else None, "%d"),
         fmt(max(rss) / 1024 if rss else None, "%.1f"), refs]))
