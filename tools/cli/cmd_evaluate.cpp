@@ -128,7 +128,7 @@ int read_trajectory_file(const std::string& path, std::vector<io::StampedPose>* 
   return kExitOk;
 }
 
-// ---- the two evaluations ----------------------------------------------------------------
+// ---- the evaluations --------------------------------------------------------------------
 
 int run_relations(const EvaluateArgs& a, std::string* json) {
   std::vector<eval::Relation> relations;
