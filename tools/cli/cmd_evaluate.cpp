@@ -28,6 +28,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_common.h"
@@ -37,6 +38,7 @@
 #include "sdpslam/eval/map_agreement.h"
 #include "sdpslam/eval/relations.h"
 #include "sdpslam/eval/rpe.h"
+#include "sdpslam/eval/stamp_match.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
@@ -299,8 +301,7 @@ int run_map_agreement(const EvaluateArgs& a, std::string* json) {
   std::vector<io::StampedPose> estimate;
   if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
   // Logs are not always in time order (intel.clf), and trajectories follow the log.
-  std::stable_sort(estimate.begin(), estimate.end(),
-                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
+  estimate = eval::sorted_by_stamp(std::move(estimate));
   io::OccupancyImage map;
   io::MapWriteOptions thresholds;
   std::string error;

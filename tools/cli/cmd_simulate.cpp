@@ -139,7 +139,7 @@ void add_sim_option(CLI::App& app, SimulateArgs* args, const std::string& name, 
                     const std::string& help) {
   CLI::Option* option = app.add_option(name, field(args->options), help)->capture_default_str();
   using Value = std::remove_reference_t<decltype(field(args->options))>;
-  if constexpr (std::is_integral_v<Value> && std::is_unsigned_v<Value>) {
+  if constexpr (std::is_integral_v<Value> && std::is_unsigned_v<Value> && !std::is_same_v<Value, bool>) {
     option->check(whole_number(std::numeric_limits<Value>::max()));
   }
   args->keep_given.push_back([option, field](const sim::SimulationOptions& given, sim::SimulationOptions* out) {

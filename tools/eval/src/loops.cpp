@@ -74,9 +74,7 @@ bool read_loops(const std::string& path, std::vector<LoopLine>* lines, std::stri
 
 LoopsResult check_loops(const std::vector<LoopLine>& lines, const std::vector<io::StampedPose>& ground_truth,
                         std::int64_t tolerance_us) {
-  std::vector<io::StampedPose> sorted = ground_truth;
-  std::stable_sort(sorted.begin(), sorted.end(),
-                   [](const io::StampedPose& a, const io::StampedPose& b) { return a.stamp_us < b.stamp_us; });
+  const std::vector<io::StampedPose> sorted = sorted_by_stamp(ground_truth);
   LoopsResult r;
   r.count = lines.size();
   for (const LoopLine& l : lines) {

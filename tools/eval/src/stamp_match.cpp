@@ -4,12 +4,16 @@
 
 namespace sdpslam::eval {
 
+std::vector<io::StampedPose> sorted_by_stamp(std::vector<io::StampedPose> poses) {
+  std::stable_sort(poses.begin(), poses.end(),
+                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
+  return poses;
+}
+
 std::vector<PosePair> pair_by_stamp(const std::vector<io::StampedPose>& estimate,
                                     const std::vector<io::StampedPose>& ground_truth, std::int64_t tolerance_us,
                                     std::size_t* unmatched) {
-  std::vector<io::StampedPose> gt = ground_truth;
-  std::stable_sort(gt.begin(), gt.end(),
-                   [](const io::StampedPose& x, const io::StampedPose& y) { return x.stamp_us < y.stamp_us; });
+  const std::vector<io::StampedPose> gt = sorted_by_stamp(ground_truth);
   std::vector<PosePair> pairs;
   pairs.reserve(estimate.size());
   std::size_t missed = 0;

@@ -37,6 +37,10 @@ std::vector<PosePair> pair_by_stamp(const std::vector<io::StampedPose>& estimate
                                     const std::vector<io::StampedPose>& ground_truth, std::int64_t tolerance_us,
                                     std::size_t* unmatched);
 
+// The poses in ascending stamp order (stable: equal stamps keep their order), as
+// find_stamp() needs them.
+std::vector<io::StampedPose> sorted_by_stamp(std::vector<io::StampedPose> poses);
+
 // True iff stamps are strictly increasing; otherwise `*bad_index` is the first pose whose
 // stamp is not greater than its predecessor's.
 bool stamps_strictly_increasing(const std::vector<io::StampedPose>& poses, std::size_t* bad_index);
