@@ -1,7 +1,7 @@
 #include "sdpslam/daemon/slam_engine.h"
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/slam/slam_outputs.h"
 

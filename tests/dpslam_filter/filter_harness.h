@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sim_world.h"
 
 namespace sdpslam::test {

@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "sdpslam/core/beam_model.h"
+#include "sdpslam/core/bottom/beam_model.h"
 #include "sim_world.h"
 
 using namespace sdpslam;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "filter_harness.h"
-#include "sdpslam/core/scan_matcher.h"
+#include "sdpslam/core/bottom/scan_matcher.h"
 
 using namespace sdpslam;
 using sdpslam::test::FilterRig;

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/bottom/motion_model.h"
 
 using namespace sdpslam;
 

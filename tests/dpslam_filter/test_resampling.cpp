@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sdpslam/core/resampling.h"
+#include "sdpslam/core/bottom/resampling.h"
 
 using namespace sdpslam;
 

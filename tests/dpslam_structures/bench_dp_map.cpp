@@ -12,8 +12,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "sdpslam/core/ancestry_tree.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
+#include "sdpslam/core/bottom/dp_map.h"
 #include "test_rng.h"
 
 namespace {

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sdpslam/core/ancestry_tree.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
+#include "sdpslam/core/bottom/dp_map.h"
 
 namespace sdpslam::test {
 

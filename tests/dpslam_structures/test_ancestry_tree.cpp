@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
 #include "test_rng.h"
 
 using sdpslam::AncestryTree;

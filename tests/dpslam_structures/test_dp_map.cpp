@@ -11,8 +11,8 @@
 #include <utility>
 
 #include "dp_fixture.h"
-#include "sdpslam/core/dp_map.h"
-#include "sdpslam/core/view_cache.h"
+#include "sdpslam/core/bottom/dp_map.h"
+#include "sdpslam/core/bottom/view_cache.h"
 #include "test_rng.h"
 
 using sdpslam::CellObservation;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dp_fixture.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/dp_map.h"
 #include "test_rng.h"
 
 using sdpslam::CellObservation;

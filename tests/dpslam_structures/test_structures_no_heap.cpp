@@ -5,8 +5,8 @@
 #include <cstdint>
 
 #include "alloc_counter.h"
-#include "sdpslam/core/ancestry_tree.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
+#include "sdpslam/core/bottom/dp_map.h"
 #include "test_rng.h"
 
 using sdpslam::CellObservation;

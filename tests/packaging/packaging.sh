@@ -168,7 +168,7 @@ contents)
   fi
 
   # Development package: headers, static libraries, CMake package.
-  for h in core/arena.h core/pool.h core/pose2.h core/dpslam_filter.h hal/clock.h \
+  for h in core/arena.h core/pool.h core/pose2.h core/bottom/dpslam_filter.h hal/clock.h \
            drivers/linux_clock.h drivers/scip2.h drivers/socketcan_bus.h io/log_reader.h io/trajectory_io.h; do
     has "$dev" "usr/include/sdpslam/$h"
   done

@@ -3,7 +3,7 @@
 
 #include <cstring>
 
-#include "sdpslam/core/segmentation.h"
+#include "sdpslam/core/top/segmentation.h"
 
 using namespace sdpslam;
 

@@ -10,9 +10,9 @@
 #include <initializer_list>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/correlative_matcher.h"
-#include "sdpslam/core/free_space_skeleton.h"
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/loops/correlative_matcher.h"
+#include "sdpslam/core/top/free_space_skeleton.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "top_level_fixtures.h"
 
 namespace {

@@ -1,4 +1,4 @@
-// CorrelativeMatcher (core/correlative_matcher.h): the wide search behind loop closure.
+// CorrelativeMatcher (core/loops/correlative_matcher.h): the wide search behind loop closure.
 // A scene displaced by metres (far outside ICP's basin) is found within a grid cell and
 // a heading step; ICP from there lands on the truth; a corridor shifted along itself is
 // ambiguous, unrelated shapes are weak; bad input and a too-large grid are refused; the
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "CppUTest/TestHarness.h"
-#include "sdpslam/core/correlative_matcher.h"
+#include "sdpslam/core/loops/correlative_matcher.h"
 #include "top_level_fixtures.h"
 
 using namespace sdpslam;

@@ -1,4 +1,4 @@
-// FrameGraph (core/frame_graph.h): the loop-closure pose graph over submap frames.
+// FrameGraph (core/loops/frame_graph.h): the loop-closure pose graph over submap frames.
 // A drifting chain around a square loop is pulled back onto the true frames by one loop
 // constraint; a wrong loop constraint among good ones is down-weighted by the kernel; a
 // verified loop without a kernel closes a drift of metres;
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "CppUTest/TestHarness.h"
-#include "sdpslam/core/frame_graph.h"
+#include "sdpslam/core/loops/frame_graph.h"
 
 using namespace sdpslam;
 

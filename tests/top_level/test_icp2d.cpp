@@ -8,7 +8,7 @@
 #include <initializer_list>
 #include <limits>
 
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "top_level_fixtures.h"
 
 using sdpslam::Icp2d;

@@ -1,4 +1,4 @@
-// LoopClosure (core/loop_closure.h) through its own API, on submaps given by a fake
+// LoopClosure (core/loops/loop_closure.h) through its own API, on submaps given by a fake
 // owner (LoopSubmaps): a room seen by two submaps whose frames the chain placed metres
 // apart. The wide search finds the revisit and records it, verified, and the pose graph
 // then moves the drifted frame onto it; a revisit beyond the chain's drift is refused;
@@ -11,7 +11,7 @@
 
 #include "CppUTest/TestHarness.h"
 #include "sdpslam/core/box2.h"
-#include "sdpslam/core/loop_closure.h"
+#include "sdpslam/core/loops/loop_closure.h"
 #include "sdpslam/core/sdp_profile.h"
 
 using namespace sdpslam;

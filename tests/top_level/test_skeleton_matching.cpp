@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/free_space_skeleton.h"
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/top/free_space_skeleton.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "top_level_fixtures.h"
 
 using sdpslam::CellState;

@@ -4,9 +4,9 @@
 
 #include "alloc_counter.h"
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/free_space_skeleton.h"
-#include "sdpslam/core/icp2d.h"
-#include "sdpslam/core/segment_graph.h"
+#include "sdpslam/core/top/free_space_skeleton.h"
+#include "sdpslam/core/top/icp2d.h"
+#include "sdpslam/core/top/segment_graph.h"
 #include "top_level_fixtures.h"
 
 namespace {

@@ -5,8 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/free_space_skeleton.h"
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/top/free_space_skeleton.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 
 namespace sdpslam::test {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/pool.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/version.h"

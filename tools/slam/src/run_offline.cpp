@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"

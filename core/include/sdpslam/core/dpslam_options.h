@@ -5,10 +5,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/beam_model.h"
+#include "sdpslam/core/bottom/beam_model.h"
 #include "sdpslam/core/capacities.h"
-#include "sdpslam/core/motion_model.h"
-#include "sdpslam/core/scan_matcher.h"
+#include "sdpslam/core/bottom/motion_model.h"
+#include "sdpslam/core/bottom/scan_matcher.h"
 
 namespace sdpslam {
 

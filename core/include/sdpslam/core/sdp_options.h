@@ -7,8 +7,8 @@
 #include <cstdint>
 
 #include "sdpslam/core/capacities.h"
-#include "sdpslam/core/icp2d.h"
-#include "sdpslam/core/segment_graph.h"
+#include "sdpslam/core/top/icp2d.h"
+#include "sdpslam/core/top/segment_graph.h"
 
 namespace sdpslam {
 

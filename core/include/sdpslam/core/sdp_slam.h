@@ -83,15 +83,15 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/dpslam_filter.h"
-#include "sdpslam/core/frame_graph.h"
-#include "sdpslam/core/free_space_skeleton.h"
-#include "sdpslam/core/icp2d.h"
-#include "sdpslam/core/loop_closure.h"
-#include "sdpslam/core/permanent_map.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
+#include "sdpslam/core/loops/frame_graph.h"
+#include "sdpslam/core/top/free_space_skeleton.h"
+#include "sdpslam/core/top/icp2d.h"
+#include "sdpslam/core/loops/loop_closure.h"
+#include "sdpslam/core/top/permanent_map.h"
 #include "sdpslam/core/sdp_options.h"
-#include "sdpslam/core/segment_graph.h"
-#include "sdpslam/core/segmentation.h"
+#include "sdpslam/core/top/segment_graph.h"
+#include "sdpslam/core/top/segmentation.h"
 
 namespace sdpslam {
 

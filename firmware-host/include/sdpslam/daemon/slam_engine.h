@@ -1,6 +1,6 @@
 #pragma once
 // The SLAM algorithm behind sdpslamd, as a small seam so that the modes of [slam] mode
-// plug in alike: `dpslam` (the bottom-level DP-SLAM filter, core/dpslam_filter.h) and
+// plug in alike: `dpslam` (the bottom-level DP-SLAM filter, core/bottom/dpslam_filter.h) and
 // `sdp` (Segmented DP-SLAM, core/sdp_slam.h, with the [sdp] options).
 //
 // Both write what the offline runner writes from the same state, through the same code

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"

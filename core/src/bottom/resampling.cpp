@@ -1,4 +1,4 @@
-#include "sdpslam/core/resampling.h"
+#include "sdpslam/core/bottom/resampling.h"
 
 #include <limits>
 

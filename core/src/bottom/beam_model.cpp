@@ -1,4 +1,4 @@
-#include "sdpslam/core/beam_model.h"
+#include "sdpslam/core/bottom/beam_model.h"
 
 #include <cstring>
 

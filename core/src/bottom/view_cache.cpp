@@ -1,4 +1,4 @@
-#include "sdpslam/core/view_cache.h"
+#include "sdpslam/core/bottom/view_cache.h"
 
 namespace sdpslam {
 

@@ -1,4 +1,4 @@
-#include "sdpslam/core/scan_matcher.h"
+#include "sdpslam/core/bottom/scan_matcher.h"
 
 #include "sdpslam/core/det_math.h"
 

@@ -31,10 +31,10 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/dp_map.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/range_scan.h"
-#include "sdpslam/core/view_cache.h"
+#include "sdpslam/core/bottom/view_cache.h"
 
 namespace sdpslam {
 

@@ -1,5 +1,5 @@
 // Ancestry tree: prune/merge of paper §II-A, DFS interval labels, path commitment.
-#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
 
 namespace sdpslam {
 

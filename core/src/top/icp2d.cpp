@@ -1,5 +1,5 @@
 // 2D point-to-point ICP; see icp2d.h for the contract.
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/top/icp2d.h"
 
 #include <cmath>  // std::floor only (exact in IEEE-754)
 #include <limits>

@@ -49,7 +49,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pool.h"

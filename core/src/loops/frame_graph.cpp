@@ -1,4 +1,4 @@
-#include "sdpslam/core/frame_graph.h"
+#include "sdpslam/core/loops/frame_graph.h"
 
 #include "sdpslam/core/det_math.h"
 

@@ -33,7 +33,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
-#include "sdpslam/core/icp2d.h"  // Point2
+#include "sdpslam/core/top/icp2d.h"  // Point2
 
 namespace sdpslam {
 

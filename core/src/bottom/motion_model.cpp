@@ -1,4 +1,4 @@
-#include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/bottom/motion_model.h"
 
 #include "sdpslam/core/det_math.h"
 

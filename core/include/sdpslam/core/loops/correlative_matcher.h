@@ -36,7 +36,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 
 namespace sdpslam {

@@ -1,4 +1,4 @@
-#include "sdpslam/core/permanent_map.h"
+#include "sdpslam/core/top/permanent_map.h"
 
 namespace sdpslam {
 

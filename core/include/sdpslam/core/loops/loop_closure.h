@@ -41,9 +41,9 @@
 #include <cstdint>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/correlative_matcher.h"
-#include "sdpslam/core/frame_graph.h"
-#include "sdpslam/core/icp2d.h"
+#include "sdpslam/core/loops/correlative_matcher.h"
+#include "sdpslam/core/loops/frame_graph.h"
+#include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
 

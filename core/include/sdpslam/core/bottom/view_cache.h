@@ -15,7 +15,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/dp_map.h"
 
 namespace sdpslam {
 

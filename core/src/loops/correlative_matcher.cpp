@@ -1,4 +1,4 @@
-#include "sdpslam/core/correlative_matcher.h"
+#include "sdpslam/core/loops/correlative_matcher.h"
 
 #include "sdpslam/core/det_math.h"
 

@@ -1,5 +1,5 @@
 // Distributed particle map: tiled grid of per-cell observation lists (paper §II-A).
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/dp_map.h"
 
 #include <cmath>
 

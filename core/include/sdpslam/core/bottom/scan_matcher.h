@@ -27,9 +27,9 @@
 //    min_mean_log_likelihood: the scan does not fit the map anywhere near (kScoreTooLow).
 #include <cstdint>
 
-#include "sdpslam/core/beam_model.h"
-#include "sdpslam/core/dp_map.h"
-#include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/bottom/beam_model.h"
+#include "sdpslam/core/bottom/dp_map.h"
+#include "sdpslam/core/bottom/motion_model.h"
 #include "sdpslam/core/pose2.h"
 
 namespace sdpslam {

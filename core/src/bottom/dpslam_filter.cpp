@@ -1,10 +1,10 @@
-#include "sdpslam/core/dpslam_filter.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 
 #include <cstdio>
 
 #include "sdpslam/core/det_math.h"
-#include "sdpslam/core/resampling.h"
-#include "sdpslam/core/scan_matcher.h"
+#include "sdpslam/core/bottom/resampling.h"
+#include "sdpslam/core/bottom/scan_matcher.h"
 
 namespace sdpslam {
 namespace {

@@ -36,15 +36,15 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/ancestry_tree.h"
+#include "sdpslam/core/bottom/ancestry_tree.h"
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/beam_model.h"
-#include "sdpslam/core/dp_map.h"
+#include "sdpslam/core/bottom/beam_model.h"
+#include "sdpslam/core/bottom/dp_map.h"
 #include "sdpslam/core/dpslam_options.h"
-#include "sdpslam/core/motion_model.h"
+#include "sdpslam/core/bottom/motion_model.h"
 #include "sdpslam/core/range_scan.h"
 #include "sdpslam/core/rng.h"
-#include "sdpslam/core/view_cache.h"
+#include "sdpslam/core/bottom/view_cache.h"
 
 namespace sdpslam {
 
