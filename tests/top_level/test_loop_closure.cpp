@@ -2,6 +2,7 @@
 // owner (LoopSubmaps): a room seen by two submaps whose frames the chain placed metres
 // apart. The wide search finds the revisit and records it, verified, and the pose graph
 // then moves the drifted frame onto it; a revisit beyond the chain's drift is refused;
+// one that needs more than half the search window waits for a later level to agree;
 // the top level's matches are
 // refined and kept one per pair of levels, the best residual winning; a full store makes
 // room with a record whose levels are gone; nothing is searched without a window.
@@ -198,7 +199,8 @@ TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_refused) {
   CHECK_EQUAL(0U, rig->stats.loop_search_closed);
   CHECK_EQUAL(0U, rig->loops.record_count());
   CHECK_EQUAL(0, o.verified);
-  // With loop_search_drift_m = 3 m (5.2 m over √3 hops) the same revisit closes.
+  // With loop_search_drift_m = 3 m (5.2 m over √3 hops) the peak is credible, but it
+  // moves the submap more than half the search window: held for a second opinion.
   const std::vector<Owner::Level> levels = o.levels;
   delete rig;
   rig = new Rig();
@@ -206,8 +208,53 @@ TEST(LoopClosure, a_revisit_beyond_the_chain_drift_is_refused) {
   rig->owner.levels = levels;
   CHECK_TRUE(rig->init());
   rig->search_all();
-  CHECK_EQUAL(1U, rig->loops.record_count());
-  CHECK_TRUE(distance_m(rig->loops.record(0).z, truth3) < 0.05);
+  CHECK_EQUAL(0U, rig->stats.loop_search_far);
+  CHECK_EQUAL(1U, rig->stats.loop_search_held);
+  CHECK_EQUAL(0U, rig->loops.record_count());
+  CHECK_EQUAL(0, rig->owner.verified);
+}
+
+// Levels 3 and 4 both revisit level 0's room, the chain 5 m off for both (more than half
+// the 6 m window): level 3's peak is held, level 4's places level 4 where the held one
+// does, and both become constraints. A second peak that disagrees confirms nothing.
+TEST(LoopClosure, a_large_correction_needs_a_later_level_that_agrees) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  const Pose2 truth4{1.0, 2.0, 0.2};
+  const Pose2 off{5.0, 0.0, 0.05};  // the chain's error, the same for levels 3 and 4
+  const Pose2 believed3 = truth3.compose(off);
+  auto build = [&](const Pose2& believed4) {
+    Owner& o = rig->owner;
+    o.levels.push_back({Pose2{}, room()});
+    o.levels.push_back({Pose2{0.0, 60.0, 0.0}, corridor(30.0)});
+    o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+    o.levels.push_back({believed3, seen_from(room(), Pose2{}, truth3)});
+    o.levels.push_back({believed4, seen_from(room(), Pose2{}, truth4)});
+    rig->options.loop_search_drift_m = 3.0;
+    CHECK_TRUE(rig->init());
+    rig->search_all();
+  };
+  // Level 4 as the chain has it: believed3 ⊕ (truth3⁻¹ ⊕ truth4).
+  build(believed3.compose(between(truth3, truth4)));
+  CHECK_EQUAL(1U, rig->stats.loop_search_held);  // level 3's
+  CHECK_EQUAL(1U, rig->stats.loop_search_confirmed);
+  CHECK_EQUAL(1U, rig->stats.loop_search_closed);  // level 4's
+  CHECK_EQUAL(2U, rig->loops.record_count());
+  CHECK_EQUAL(1, rig->owner.verified);
+  for (std::uint32_t k = 0; k < 2U; ++k) {
+    const LoopClosure::Record& r = rig->loops.record(k);
+    CHECK_EQUAL(0U, r.older_level);
+    CHECK_TRUE(r.searched);
+    CHECK_TRUE(distance_m(r.z, r.newer_level == 3U ? truth3 : truth4) < 0.05);
+  }
+  // Level 4 placed 4 m off the other way: its own peak is as good, but the two disagree
+  // by metres about where level 4 is. Both stay held; nothing is recorded.
+  delete rig;
+  rig = new Rig();
+  build(truth4.compose(Pose2{-4.0, 0.0, 0.0}));
+  CHECK_EQUAL(2U, rig->stats.loop_search_held);
+  CHECK_EQUAL(0U, rig->stats.loop_search_confirmed);
+  CHECK_EQUAL(0U, rig->loops.record_count());
+  CHECK_EQUAL(0, rig->owner.verified);
 }
 
 // The top level's skeleton match, refined on obstacle points: one record per pair of

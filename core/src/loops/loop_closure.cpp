@@ -22,6 +22,15 @@ FrameGraphOptions graph_options(const SdpOptions& s, std::uint32_t max_nodes) {
   return o;
 }
 
+// The four corners of a box (submap frame: x0, y0, x1, y1) placed by `frame`, as x, y pairs.
+void box_corners(const Pose2& frame, const double b[4], double out[8]) {
+  for (std::uint32_t i = 0; i < 4U; ++i) {
+    const Pose2 c = frame.compose(Pose2{(i & 1U) != 0U ? b[2] : b[0], (i & 2U) != 0U ? b[3] : b[1], 0.0});
+    out[2U * i] = c.x_m;
+    out[2U * i + 1U] = c.y_m;
+  }
+}
+
 }  // namespace
 
 std::size_t LoopClosure::required_bytes(const SdpOptions& s, std::uint32_t max_nodes, const LoopSearchGeometry& g) {
@@ -46,6 +55,7 @@ bool LoopClosure::init(const SdpOptions& s, std::uint32_t max_nodes, const LoopS
   search_level_ = 0U;
   search_count_ = 0U;
   search_cursor_ = 0U;
+  held_count_ = 0U;
   records_ = arena.allocate_array<Record>(s.max_loop_constraints);
   if (records_ == nullptr || !graph_.init(graph_options(s, max_nodes), arena)) return false;
   if (s.loop_search_window_m > 0.0) {
@@ -321,7 +331,90 @@ void LoopClosure::search_continue() {
     ++stats_->loop_search_far;
     return;
   }
-  search_accept(lr);
+  search_second_opinion(lr);
+}
+
+// The search proves a peak unique only within its window, which is centred on where the
+// chain puts the newer submap. A peak that moves the submap (its box centre) by at most
+// half the window has the other half on every side of it searched too: a repeated
+// structure at up to that distance from it would have shown as a rival peak
+// (kAmbiguous), so it is accepted. A peak farther out had part of its surroundings
+// outside the window, where its alias (or the true place) may lie unseen: one such
+// peak is not enough. It is held until the search of another (later) level finds a
+// peak that places that level within loop_max_correction_m (every corner of its box)
+// of where the held one does; both then become constraints. A true revisit goes on for
+// more than one segment, so later levels see the same place again through other walls;
+// an alias is rarely repeated at the same offset from different structure. (The
+// consistency check of ORB-SLAM's loop candidates, Mur-Artal et al. 2015, §VI-A, on
+// submaps.) Held peaks wait in a small FIFO; the oldest gives way.
+void LoopClosure::search_second_opinion(const Record& r) {
+  double via_r[8];
+  if (!corners_via(r, r.newer_level, via_r)) return;
+  Pose2 fn;
+  double nb[4];
+  std::uint32_t n = 0U;
+  if (!submaps_->placement(r.newer_level, &fn, nb, &n)) return;
+  double now[8];
+  box_corners(fn, nb, now);
+  const double tol = options_.loop_max_correction_m;
+  double cx = 0.0;
+  double cy = 0.0;
+  for (std::uint32_t i = 0; i < 4U; ++i) {
+    cx += 0.25 * (via_r[2U * i] - now[2U * i]);
+    cy += 0.25 * (via_r[2U * i + 1U] - now[2U * i + 1U]);
+  }
+  const double half = 0.5 * options_.loop_search_window_m;
+  if (cx * cx + cy * cy <= half * half) {
+    search_accept(r);
+    return;
+  }
+  for (std::uint32_t k = 0; k < held_count_; ++k) {
+    const Record& h = held_[k];
+    if (h.newer_level == r.newer_level) continue;  // the same submap sees the same structure
+    double via_h[8];
+    if (!corners_via(h, r.newer_level, via_h) || corner_distance(via_h, via_r) > tol) continue;
+    const Record confirmed = h;
+    for (std::uint32_t j = k + 1U; j < held_count_; ++j) held_[j - 1U] = held_[j];
+    --held_count_;
+    ++stats_->loop_search_confirmed;  // its search was counted held
+    record(confirmed);
+    search_accept(r);
+    return;
+  }
+  if (held_count_ == kHeldLoops) {
+    for (std::uint32_t j = 1U; j < held_count_; ++j) held_[j - 1U] = held_[j];
+    --held_count_;
+  }
+  held_[held_count_++] = r;
+  ++stats_->loop_search_held;
+}
+
+bool LoopClosure::corners_via(const Record& r, std::uint32_t level, double out[8]) const {
+  std::uint32_t n = 0U;
+  Pose2 fo;
+  Pose2 fn;
+  Pose2 fl;
+  double ob[4];
+  double nb[4];
+  double lb[4];
+  if (!submaps_->placement(r.older_level, &fo, ob, &n) || !submaps_->placement(r.newer_level, &fn, nb, &n) ||
+      !submaps_->placement(level, &fl, lb, &n) || !box_valid(lb)) {
+    return false;
+  }
+  // The level's frame as r places it: older frame, r, then the chain from r's newer level.
+  box_corners(fo.compose(r.z).compose(fn.inverse().compose(fl)), lb, out);
+  return true;
+}
+
+double LoopClosure::corner_distance(const double a[8], const double b[8]) const {
+  double worst = 0.0;
+  for (std::uint32_t i = 0; i < 4U; ++i) {
+    const double dx = a[2U * i] - b[2U * i];
+    const double dy = a[2U * i + 1U] - b[2U * i + 1U];
+    const double d2 = dx * dx + dy * dy;
+    if (d2 > worst) worst = d2;
+  }
+  return det::sqrt(worst);
 }
 
 void LoopClosure::search_accept(const Record& r) {

@@ -275,7 +275,8 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
         ", \"pairs\": " + u(st.loop_searches) + ", \"weak\": " + u(st.loop_search_weak) + ", \"ambiguous\": " +
         u(st.loop_search_ambiguous) + ", \"failed\": " + u(st.loop_search_failed) + ", \"refuted\": " +
         u(st.loop_search_refuted) + ", \"closed\": " + u(st.loop_search_closed) + ", \"far\": " +
-        u(st.loop_search_far) + "}},\n";
+        u(st.loop_search_far) + ", \"held\": " + u(st.loop_search_held) + ", \"confirmed\": " +
+        u(st.loop_search_confirmed) + "}},\n";
   js += "  \"pools\": {\n";
   js += filter_pools_json(bottom);
   js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +

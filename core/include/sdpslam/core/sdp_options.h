@@ -162,7 +162,9 @@ struct SdpOptions {
   // drifts like a random walk; a recorded loop is a short cut). Repeated structure
   // (doors, pillars at a regular pitch) makes peaks that are metres off and would pull
   // the map apart; a true loop's correction grows like the chain's random-walk drift.
-  // A refused or weak peak is not held for a second opinion from another older submap:
+  // A credible peak that moves the newer submap by more than half the window waits for
+  // a later level's search to agree with it (loop_closure.h). A refused or weak peak is
+  // not held for a second opinion from another older submap:
   // the candidates all overlap the newer submap, so they overlap each other too and see
   // the same repeated structure, and an aliased peak against one recurs against the
   // next. 0: off.
