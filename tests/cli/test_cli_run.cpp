@@ -335,6 +335,34 @@ TEST(CliRun, numbers_out_of_range_and_an_empty_output_folder_are_usage_errors) {
 // simulated run's constraints can be checked against its ground truth: on the paper
 // world every constraint the run used is right (within 0.5 m), which it can only be if
 // the origins are the levels' true ones.
+// The state is sized from the options and checked against --memory-budget-mib before
+// the log is read: a capacity with digits too many is refused with the size it asks
+// for, and nothing is written.
+TEST(CliRun, a_state_above_the_memory_budget_is_refused_before_any_work) {
+  const std::string log = log_with_bad_lines(0);
+  const std::string ini = dir + "/huge.ini";
+  {
+    std::ofstream f(ini);
+    f << "[sdp]\nmap_observation_capacity = 1000000000\n";
+  }
+  Run r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("the SLAM state needs ", r.out.c_str());
+  STRCMP_CONTAINS(" MiB, above --memory-budget-mib 128", r.out.c_str());
+  struct stat st {};
+  CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));  // nothing ran
+  // The default options fit 64 MiB in sdp mode; the DP-SLAM baseline's larger map does not.
+  r = run_cli("run " + log + " --memory-budget-mib 64 --quiet --out " + dir + "/b");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  r = run_cli("run " + log + " --mode dpslam --memory-budget-mib 64 --out " + dir + "/c");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("above --memory-budget-mib 64", r.out.c_str());
+  r = run_cli("run " + log + " --memory-budget-mib 7 --out " + dir + "/c");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--memory-budget-mib", r.out.c_str());
+  CHECK_EQUAL(-1, ::stat((dir + "/c").c_str(), &st));
+}
+
 TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   Run r = run_cli("simulate --world paper --seed 4 --quiet --out " + dir + "/sim");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());

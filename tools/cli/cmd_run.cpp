@@ -1,6 +1,6 @@
 // `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
 //               [--topology sdp|segslam] [--profile accurate|paper] [--config FILE.ini]
-//               [--seed S] --out DIR`
+//               [--seed S] [--memory-budget-mib M] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
 // (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
@@ -13,11 +13,16 @@
 
 #include "cli_common.h"
 #include "sdpslam/slam/run_offline.h"
+#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_profile.h"
+#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/slam/run_sdp.h"
 
 namespace sdpslam::cli {
 namespace {
+
+// The same default as sdpslamd's [daemon] memory_budget_mib.
+constexpr std::uint32_t kDefaultMemoryBudgetMib = 128U;
 
 struct RunArgs {
   std::string log;
@@ -30,11 +35,33 @@ struct RunArgs {
   std::string config;
   std::uint64_t seed = 1U;
   std::string out;
+  std::uint32_t memory_budget_mib = kDefaultMemoryBudgetMib;
 };
 
 int report(const char* what, int code, const std::string& error) {
   std::fprintf(stderr, "sdpslam run: %s%s\n", what, error.c_str());
   return code;
+}
+
+// The whole SLAM state is one arena sized from the options before any work (the fixed
+// memory of the core). It must fit the declared budget, as sdpslamd's [daemon]
+// memory_budget_mib: a capacity with a digit too many asks for gigabytes, and is refused
+// here with the size it asked for instead of failing or swapping mid-run. 0 bytes: the
+// options' sizes overflow.
+int check_memory_budget(const RunArgs& a, std::size_t arena_bytes) {
+  if (arena_bytes == 0U) {
+    return report("", kExitUsage, "the options' state size overflows (lower the [map]/[sdp] capacities)");
+  }
+  const double need_mib = static_cast<double>(arena_bytes) / (1024.0 * 1024.0);
+  if (need_mib > static_cast<double>(a.memory_budget_mib)) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the SLAM state needs %.1f MiB, above --memory-budget-mib %u (lower the [map]/[sdp] capacities or "
+                  "raise the budget)",
+                  need_mib, a.memory_budget_mib);
+    return report("", kExitUsage, text);
+  }
+  return kExitOk;
 }
 
 // Whether the INI file has a `[name]` section (the file was read whole before: a read
@@ -102,6 +129,9 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   if (!ro.config.filter.validate(why, sizeof why) || !ro.sdp.validate(why, sizeof why)) {
     return report("", kExitUsage, why);
   }
+  if (const int rc = check_memory_budget(a, SdpSlam::required_arena_bytes(ro.config.filter, ro.sdp)); rc != kExitOk) {
+    return rc;
+  }
   ro.seed = a.seed;
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
@@ -132,6 +162,9 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   if (a.particles != 0U) ro.config.filter.particle_count = a.particles;
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
+  if (const int rc = check_memory_budget(a, DpSlamFilter::required_arena_bytes(ro.config.filter)); rc != kExitOk) {
+    return rc;
+  }
   ro.seed = a.seed;
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
@@ -176,6 +209,11 @@ std::function<int()> setup_run(CLI::App& app) {
                  "INI options on top of the profile: bottom level and [sdp] (see tools/slam/default.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)")->check(whole_number(UINT64_MAX));
   app.add_option("--out", args->out, "Output directory")->required()->check(non_empty());
+  app.add_option("--memory-budget-mib", args->memory_budget_mib,
+                 "The SLAM state (sized before any work) may not exceed this, as sdpslamd's [daemon] "
+                 "memory_budget_mib (default 128)")
+      ->check(whole_number(65536U))
+      ->check(CLI::Range(8U, 65536U));
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
