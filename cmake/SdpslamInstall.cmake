@@ -138,6 +138,35 @@ endif()
 set(SDPSLAM_DEB_MAINTAINER "sdpslam maintainers <sdpslam@localhost>" CACHE STRING
   "Maintainer field of the Debian packages")
 
+# Each package's Debian changelog and the programs' manual pages, compressed as Debian
+# wants them (gzip -9n: no name or time stamp, so the packages are reproducible).
+function(sdpslam_gzip_doc source output)
+  get_filename_component(_dir "${output}" DIRECTORY)
+  file(MAKE_DIRECTORY "${_dir}")
+  execute_process(COMMAND gzip -9nc "${source}" OUTPUT_FILE "${output}" RESULT_VARIABLE _rc)
+  if(NOT _rc EQUAL 0)
+    message(FATAL_ERROR "gzip -9n ${source} failed (${_rc})")
+  endif()
+  set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${source}")
+endfunction()
+set(_sdpslam_docs "${PROJECT_BINARY_DIR}/debian-doc")
+configure_file("${CMAKE_CURRENT_LIST_DIR}/debian/changelog.in" "${_sdpslam_docs}/changelog.Debian" @ONLY)
+sdpslam_gzip_doc("${_sdpslam_docs}/changelog.Debian" "${_sdpslam_docs}/changelog.Debian.gz")
+install(FILES "${_sdpslam_docs}/changelog.Debian.gz" DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/libsdpslam-dev
+  COMPONENT dev)
+if(TARGET sdpslam OR TARGET sdpslamd)
+  install(FILES "${_sdpslam_docs}/changelog.Debian.gz" DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/sdpslam
+    COMPONENT runtime)
+endif()
+if(TARGET sdpslam)
+  sdpslam_gzip_doc("${CMAKE_CURRENT_LIST_DIR}/man/sdpslam.1" "${_sdpslam_docs}/sdpslam.1.gz")
+  install(FILES "${_sdpslam_docs}/sdpslam.1.gz" DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
+endif()
+if(TARGET sdpslamd)
+  sdpslam_gzip_doc("${CMAKE_CURRENT_LIST_DIR}/man/sdpslamd.8" "${_sdpslam_docs}/sdpslamd.8.gz")
+  install(FILES "${_sdpslam_docs}/sdpslamd.8.gz" DESTINATION ${CMAKE_INSTALL_MANDIR}/man8 COMPONENT runtime)
+endif()
+
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME sdpslam)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
@@ -160,15 +189,17 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME sdpslam)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION science)
 # First line: the synopsis; the rest: the long description (CPack indents it).
 set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "Segmented DP-SLAM onboard program and tools
-sdpslamd builds a map and the robot's trajectory on the robot's computer from wheel
-encoders (SocketCAN) and a laser rangefinder (serial port), in fixed memory. The sdpslam
-command simulates, converts logs, runs SLAM offline and evaluates. The systemd unit
-sdpslamd.service is installed but not enabled.")
+sdpslamd builds a map and the robot's trajectory on the robot's computer
+from wheel encoders (SocketCAN) and a laser rangefinder (serial port), in
+fixed memory. The sdpslam command simulates, converts logs, runs SLAM
+offline and evaluates. The systemd unit sdpslamd.service is installed but
+not enabled.")
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libsdpslam-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DEV_DESCRIPTION "Segmented DP-SLAM library: headers, static libraries, CMake package
-find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal, sdpslam::drivers
-and sdpslam::io. The libraries are static: the core is linked into the robot's firmware.")
+find_package(sdpslam CONFIG REQUIRED) gives sdpslam::core, sdpslam::hal,
+sdpslam::drivers and sdpslam::io. The libraries are static: the core is
+linked into the robot's firmware.")
 # The CMake package finds these (sdpslamConfig.cmake); the core needs nothing.
 if(SDPSLAM_EXPORTS_IO)
   set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, zlib1g-dev")
@@ -190,9 +221,9 @@ endif()
 if(_sdpslam_has_daemon)
   set(_extra "${PROJECT_BINARY_DIR}/debian-runtime")
   file(MAKE_DIRECTORY "${_extra}")
-  file(COPY "${CMAKE_CURRENT_LIST_DIR}/debian/postinst" "${CMAKE_CURRENT_LIST_DIR}/debian/postrm"
-    DESTINATION "${_extra}")
-  set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA "${_extra}/postinst;${_extra}/postrm")
+  file(COPY "${CMAKE_CURRENT_LIST_DIR}/debian/postinst" "${CMAKE_CURRENT_LIST_DIR}/debian/prerm"
+    "${CMAKE_CURRENT_LIST_DIR}/debian/postrm" DESTINATION "${_extra}")
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA "${_extra}/postinst;${_extra}/prerm;${_extra}/postrm")
   if(_sdpslam_conffiles)
     list(JOIN _sdpslam_conffiles "\n" _lines)
     file(WRITE "${_extra}/conffiles" "${_lines}\n")
