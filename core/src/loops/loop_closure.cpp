@@ -349,11 +349,13 @@ void LoopClosure::search_continue() {
 // submaps.) Held peaks wait in a small FIFO; the oldest gives way.
 void LoopClosure::search_second_opinion(const Record& r) {
   double via_r[8];
-  if (!corners_via(r, r.newer_level, via_r)) return;
   Pose2 fn;
   double nb[4];
   std::uint32_t n = 0U;
-  if (!submaps_->placement(r.newer_level, &fn, nb, &n)) return;
+  if (!corners_via(r, r.newer_level, via_r) || !submaps_->placement(r.newer_level, &fn, nb, &n)) {
+    ++stats_->loop_search_failed;  // a level was forgotten while it was searched
+    return;
+  }
   double now[8];
   box_corners(fn, nb, now);
   const double tol = options_.loop_max_correction_m;
