@@ -13,9 +13,7 @@
 
 #include "cli_common.h"
 #include "sdpslam/slam/run_offline.h"
-#include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_profile.h"
-#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/slam/run_sdp.h"
 
 namespace sdpslam::cli {
@@ -44,7 +42,9 @@ int report(const char* what, int code, const std::string& error) {
 }
 
 // The whole SLAM state is one arena sized from the options before any work (the fixed
-// memory of the core). It must fit the declared budget, as sdpslamd's [daemon]
+// memory of the core). It is sized by the runners, which own the core's classes: the
+// command line includes none of their headers (the core is built without RTTI, and
+// UBSan's vptr check then refuses the core's objects in the host tools). It must fit the declared budget, as sdpslamd's [daemon]
 // memory_budget_mib: a capacity with a digit too many asks for gigabytes, and is refused
 // here with the size it asked for instead of failing or swapping mid-run. 0 bytes: the
 // options' sizes overflow.
@@ -129,7 +129,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   if (!ro.config.filter.validate(why, sizeof why) || !ro.sdp.validate(why, sizeof why)) {
     return report("", kExitUsage, why);
   }
-  if (const int rc = check_memory_budget(a, SdpSlam::required_arena_bytes(ro.config.filter, ro.sdp)); rc != kExitOk) {
+  if (const int rc = check_memory_budget(a, slam::sdp_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }
   ro.seed = a.seed;
@@ -162,7 +162,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   if (a.particles != 0U) ro.config.filter.particle_count = a.particles;
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
-  if (const int rc = check_memory_budget(a, DpSlamFilter::required_arena_bytes(ro.config.filter)); rc != kExitOk) {
+  if (const int rc = check_memory_budget(a, slam::dpslam_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }
   ro.seed = a.seed;

@@ -33,6 +33,10 @@ using detail::thread_cpu_ms;
 
 }  // namespace
 
+std::size_t dpslam_state_bytes(const RunOptions& options) {
+  return DpSlamFilter::required_arena_bytes(options.config.filter);
+}
+
 RunStatus run_offline(const std::string& log_path, const RunOptions& options, const std::string& out_dir,
                       RunSummary* summary, std::string* error) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -49,7 +53,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   io::OutputSet outputs;
   if (!outputs.begin(out_dir, error)) return RunStatus::kIoError;
 
-  const std::size_t arena_bytes = DpSlamFilter::required_arena_bytes(fo);
+  const std::size_t arena_bytes = dpslam_state_bytes(options);
   std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
   Arena arena(buffer.get(), arena_bytes);
   auto filter = std::make_unique<DpSlamFilter>();

@@ -288,6 +288,10 @@ bool load_sdp_ini(std::FILE* stream, const std::string& name, SdpOptions* option
   return false;
 }
 
+std::size_t sdp_state_bytes(const SdpRunOptions& options) {
+  return SdpSlam::required_arena_bytes(options.config.filter, options.sdp);
+}
+
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -305,7 +309,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   if (!outputs.begin(out_dir, error)) return SdpRunStatus::kIoError;
 
   // The whole state: one arena sized at init (the fixed memory budget).
-  const std::size_t arena_bytes = SdpSlam::required_arena_bytes(fo, options.sdp);
+  const std::size_t arena_bytes = sdp_state_bytes(options);
   if (arena_bytes == 0U) {
     *error = "invalid options (arena size)";
     return SdpRunStatus::kBadInput;

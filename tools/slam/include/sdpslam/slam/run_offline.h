@@ -47,6 +47,10 @@ struct RunSummary {
 
 enum class RunStatus { kOk, kBadInput, kIoError, kInternal };
 
+// Bytes of the DP-SLAM filter's state these options ask for (the arena run_offline
+// allocates: DpSlamFilter::required_arena_bytes), known before any work.
+std::size_t dpslam_state_bytes(const RunOptions& options);
+
 RunStatus run_offline(const std::string& log_path, const RunOptions& options, const std::string& out_dir,
                       RunSummary* summary, std::string* error);
 

@@ -62,6 +62,11 @@ struct SdpRunSummary {
 
 enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };
 
+// Bytes of the whole SLAM state these options ask for (the one arena run_sdp_offline
+// allocates: SdpSlam::required_arena_bytes), known before any work; 0 when the options
+// are invalid or their sizes overflow.
+std::size_t sdp_state_bytes(const SdpRunOptions& options);
+
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error);
 
