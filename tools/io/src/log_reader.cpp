@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -52,8 +53,9 @@ class LineSource {
       *error = path + ": cannot open: " + (errno != 0 ? std::strerror(errno) : "out of memory");
       return false;
     }
-    gzbuffer(file_, 256U * 1024U);
-    buf_.resize(256U * 1024U);
+    gzbuffer(file_, kReadChunkBytes);
+    // Left uninitialised: gzread fills it, and only the bytes it reports are read.
+    if (buf_ == nullptr) buf_.reset(new char[kReadChunkBytes]);
     return true;
   }
 
@@ -72,7 +74,7 @@ class LineSource {
       if (pos_ == len_) {
         if (!fill()) return any;
       }
-      const char* start = buf_.data() + pos_;
+      const char* start = buf_.get() + pos_;
       const std::size_t avail = len_ - pos_;
       const void* nl = std::memchr(start, '\n', avail);
       const std::size_t take = nl != nullptr ? static_cast<std::size_t>(static_cast<const char*>(nl) - start) : avail;
@@ -106,7 +108,7 @@ class LineSource {
  private:
   bool fill() {
     if (file_ == nullptr || eof_) return false;
-    const int got = gzread(file_, buf_.data(), static_cast<unsigned>(buf_.size()));
+    const int got = gzread(file_, buf_.get(), kReadChunkBytes);
     if (got <= 0) {
       eof_ = true;
       int errnum = Z_OK;
@@ -123,7 +125,8 @@ class LineSource {
   }
 
   gzFile file_ = nullptr;
-  std::vector<char> buf_;
+  static constexpr unsigned kReadChunkBytes = 64U * 1024U;
+  std::unique_ptr<char[]> buf_;
   std::size_t pos_ = 0;
   std::size_t len_ = 0;
   bool eof_ = false;
