@@ -349,24 +349,15 @@ void LoopClosure::search_continue() {
 // submaps.) Held peaks wait in a small FIFO; the oldest gives way.
 void LoopClosure::search_second_opinion(const Record& r) {
   double via_r[8];
-  Pose2 fn;
-  double nb[4];
-  std::uint32_t n = 0U;
-  if (!corners_via(r, r.newer_level, via_r) || !submaps_->placement(r.newer_level, &fn, nb, &n)) {
+  double dx = 0.0;
+  double dy = 0.0;
+  if (!corners_via(r, r.newer_level, via_r) || !centre_shift(r, &dx, &dy)) {
     ++stats_->loop_search_failed;  // a level was forgotten while it was searched
     return;
   }
-  double now[8];
-  box_corners(fn, nb, now);
   const double tol = options_.loop_max_correction_m;
-  double cx = 0.0;
-  double cy = 0.0;
-  for (std::uint32_t i = 0; i < 4U; ++i) {
-    cx += 0.25 * (via_r[2U * i] - now[2U * i]);
-    cy += 0.25 * (via_r[2U * i + 1U] - now[2U * i + 1U]);
-  }
   const double half = 0.5 * options_.loop_search_window_m;
-  if (cx * cx + cy * cy <= half * half) {
+  if (dx * dx + dy * dy <= half * half) {
     search_accept(r);
     return;
   }
@@ -425,10 +416,9 @@ void LoopClosure::search_accept(const Record& r) {
   if (!record_dead(r)) submaps_->on_verified_loop();  // the frames follow the new constraint now
 }
 
-// Whether r would move its newer submap (the centre of its box) farther from where the
-// best combination's frames put it now than the chain may have drifted between the two
-// levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
-bool LoopClosure::moves_too_far(const Record& r) const {
+// How far r moves its newer submap (the centre of its box) from where the best
+// combination's frames put it now; false if either level has no placement.
+bool LoopClosure::centre_shift(const Record& r, double* dx_m, double* dy_m) const {
   std::uint32_t n = 0U;
   Pose2 fo;
   Pose2 fn;
@@ -441,8 +431,17 @@ bool LoopClosure::moves_too_far(const Record& r) const {
   const Pose2 centre{0.5 * (nb[0] + nb[2]), 0.5 * (nb[1] + nb[3]), 0.0};
   const Pose2 now = fn.compose(centre);
   const Pose2 moved = fo.compose(r.z).compose(centre);
-  const double dx = moved.x_m - now.x_m;
-  const double dy = moved.y_m - now.y_m;
+  *dx_m = moved.x_m - now.x_m;
+  *dy_m = moved.y_m - now.y_m;
+  return true;
+}
+
+// Whether r would move its newer submap farther than the chain may have drifted between
+// the two levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
+bool LoopClosure::moves_too_far(const Record& r) const {
+  double dx = 0.0;
+  double dy = 0.0;
+  if (!centre_shift(r, &dx, &dy)) return false;
   const double limit_m2 = options_.loop_search_drift_m * options_.loop_search_drift_m *
                           static_cast<double>(level_hops(r.older_level, r.newer_level));
   return dx * dx + dy * dy > limit_m2;

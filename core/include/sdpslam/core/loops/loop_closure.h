@@ -170,6 +170,7 @@ class LoopClosure {
   // older level's frame); false if either level has no placement.
   bool corners_via(const Record& r, std::uint32_t level, double out[8]) const;
   double corner_distance(const double a[8], const double b[8]) const;
+  bool centre_shift(const Record& r, double* dx_m, double* dy_m) const;
   bool moves_too_far(const Record& r) const;
   std::uint32_t level_hops(std::uint32_t older_level, std::uint32_t newer_level) const;
 
