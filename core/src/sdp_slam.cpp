@@ -125,11 +125,47 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   return total + kSlack;
 }
 
+bool SdpSlam::check_options(const DpSlamOptions& bottom, const SdpOptions& s, char* why, std::size_t n) {
+  if (why != nullptr && n > 0U) why[0] = '\0';
+  if (!s.validate(why, n) || !bottom.validate(why, n)) return false;
+  const DpSlamOptions b = bottom_options_for(bottom, s);
+  if (!b.validate(why, n)) {
+    // Valid alone, too large once anchored segments get their pool room.
+    if (why != nullptr && n > 0U) {
+      const std::size_t len = std::strlen(why);
+      std::snprintf(why + len, n - len, " (with the pool room of sdp.max_levels = %u segments)", s.max_levels);
+    }
+    return false;
+  }
+  auto refuse = [why, n](const char* text, double a, double c) {
+    if (why != nullptr && n > 0U) std::snprintf(why, n, text, a, c);
+    return false;
+  };
+  static_assert(capacity::kMaxPgsNodesPerLevel >= capacity::kMaxBottomParticles,
+                "every bottom particle count validate() accepts has its PGS node");
+  const std::uint32_t coarse = coarse_side_cells(b, s);
+  if (coarse > capacity::kMaxSkeletonPatchSide) {
+    return refuse("sdp.skeleton_max_side_m: a skeleton patch of %.0f cells, above the %.0f cells it may have "
+                  "(raise [sdp] skeleton_downsample or [map] resolution_m)",
+                  coarse, capacity::kMaxSkeletonPatchSide);
+  }
+  // Loop closure keeps obstacle points as 16-bit cell coordinates of the map grid.
+  const double cells = (b.map_width_m > b.map_height_m ? b.map_width_m : b.map_height_m) / b.map_resolution_m;
+  if (s.loop_closure && cells > 32767.0) {
+    return refuse(b.map_width_m >= b.map_height_m
+                      ? "map.width_m: a map grid %.0f cells wide, above the %.0f that loop closure's cell "
+                        "coordinates hold (lower [map] width_m/height_m or raise resolution_m)"
+                      : "map.height_m: a map grid %.0f cells high, above the %.0f that loop closure's cell "
+                        "coordinates hold (lower [map] width_m/height_m or raise resolution_m)",
+                  cells, 32767.0);
+  }
+  return true;
+}
+
 bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& arena, std::uint64_t seed) {
   initialised_ = false;
-  if (!s.validate(why_, sizeof why_)) return false;
+  if (!check_options(bottom_in, s, why_, sizeof why_)) return false;
   const DpSlamOptions b = bottom_options_for(bottom_in, s);
-  if (!b.validate(why_, sizeof why_)) return false;
   const std::size_t need = required_arena_bytes(bottom_in, s);
   if (need == 0U || arena.available_bytes() < need) {
     std::snprintf(why_, sizeof why_, "arena too small: %zu bytes available, %zu needed", arena.available_bytes(), need);
@@ -140,11 +176,6 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   bottom_options_ = b;
   n_bottom_ = b.particle_count;
   n_top_ = s.top_particles;
-  if (n_bottom_ > capacity::kMaxPgsNodesPerLevel) {
-    std::snprintf(why_, sizeof why_, "filter.particles above the PGS nodes per level (%u)",
-                  capacity::kMaxPgsNodesPerLevel);
-    return false;
-  }
   // The bottom filter, ICP and segmenter live in the arena: placement new below (init
   // only) constructs them there; nothing comes from the heap (tests/sdp/test_sdp_no_heap).
   void* fmem = arena.allocate(sizeof(DpSlamFilter), alignof(DpSlamFilter));
@@ -180,7 +211,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     return false;
   }
   coarse_side_ = coarse_side_cells(b, s);
-  if (coarse_side_ > capacity::kMaxSkeletonPatchSide || !skeleton_.init(arena, coarse_side_, coarse_side_)) {
+  if (!skeleton_.init(arena, coarse_side_, coarse_side_)) {
     std::snprintf(why_, sizeof why_, "skeleton init failed (patch side %u cells)", coarse_side_);
     return false;
   }
@@ -207,10 +238,6 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     perm_obst_ = arena.allocate_array<CellPoint>(std::size_t{s.max_permanent_submaps} * s.loop_points);
     obst_a_ = arena.allocate_array<Point2>(s.loop_points);
     obst_b_ = arena.allocate_array<Point2>(s.loop_points);
-    if (b.map_width_m / b.map_resolution_m > 32767.0 || b.map_height_m / b.map_resolution_m > 32767.0) {
-      std::snprintf(why_, sizeof why_, "sdp.loop_closure: the map grid is wider than 32767 cells");
-      return false;
-    }
     if (live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr || obst_b_ == nullptr ||
         !loop_closure_.init(s, graph_nodes(s), search_geometry(b, s), icp_, &loop_view_, &stats_, arena)) {
       std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");

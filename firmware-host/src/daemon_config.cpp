@@ -3,6 +3,7 @@
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/serial_port.h"
+#include "sdpslam/slam/config_ini.h"
 #include "sdpslam/slam/run_sdp.h"
 
 #include <ini.h>
@@ -475,21 +476,17 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
     *error = at + "robot: " + drivers::to_string(drivers::validate(config->drive));
     return false;
   }
-  char why[200];
-  if (!config->slam.filter.validate(why, sizeof why)) {
-    *error = at + why;
+  // An option refused here is named with the line of the file that set it.
+  auto refuse = [&](const char* why) {
+    const std::string located = slam::locate_option_error(path, why);
+    *error = located != why ? located : at + why;
     return false;
-  }
-  if (config->mode == SlamMode::kSdp) {
-    if (!config->sdp.validate(why, sizeof why)) {
-      *error = at + "sdp: " + why;
-      return false;
-    }
-    // SDP-SLAM adds the pool room anchored segments need to the bottom options.
-    if (!SdpSlam::bottom_options_for(config->slam.filter, config->sdp).validate(why, sizeof why)) {
-      *error = at + "sdp: bottom level with the room for " + std::to_string(config->sdp.max_levels) + " levels: " + why;
-      return false;
-    }
+  };
+  char why[240];
+  if (!config->slam.filter.validate(why, sizeof why)) return refuse(why);
+  // Every check SDP-SLAM's init makes (SdpSlam::check_options): what is approved here starts.
+  if (config->mode == SlamMode::kSdp && !SdpSlam::check_options(config->slam.filter, config->sdp, why, sizeof why)) {
+    return refuse(why);
   }
   // The whole state is sized here, before any work: what is approved here can start.
   const std::size_t arena_bytes = engine_arena_bytes(*config);

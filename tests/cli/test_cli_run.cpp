@@ -363,6 +363,34 @@ TEST(CliRun, a_state_above_the_memory_budget_is_refused_before_any_work) {
   CHECK_EQUAL(-1, ::stat((dir + "/c").c_str(), &st));
 }
 
+// What the core would refuse at init is refused before any work, with the config line
+// that set the key (SdpSlam::check_options: limits that join several options).
+TEST(CliRun, options_the_core_cannot_start_with_are_refused_at_their_line_before_any_work) {
+  const std::string log = log_with_bad_lines(0);
+  const std::string ini = dir + "/wide.ini";
+  {
+    std::ofstream f(ini);
+    f << "[filter]\nparticles = 10\n\n[map]\nwidth_m = 3000\n";
+  }
+  Run r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS((ini + ":5: map.width_m: a map grid 60000 cells wide").c_str(), r.out.c_str());
+  struct stat st {};
+  CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));  // nothing ran, no folder made
+  {
+    std::ofstream f(ini);
+    f << "[sdp]\nskeleton_max_side_m = 400\n";
+  }
+  r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS((ini + ":2: sdp.skeleton_max_side_m: a skeleton patch of").c_str(), r.out.c_str());
+  CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));
+  // A key the command line set has no line: the reason alone.
+  r = run_cli("run " + log + " --particles 100000 --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("sdpslam run: filter.particles: 100000 out of range", r.out.c_str());
+}
+
 TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   Run r = run_cli("simulate --world paper --seed 4 --quiet --out " + dir + "/sim");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());

@@ -52,6 +52,39 @@ TEST(SdpSlam, init_refuses_invalid_options_and_a_small_arena) {
   CHECK(std::strstr(slam2.why(), "arena") != nullptr);
 }
 
+// check_options() makes init()'s checks without an arena: options it passes start with
+// an arena of required_arena_bytes(); options it refuses, init() refuses with the same
+// reason, naming the key.
+TEST(SdpSlam, check_options_is_the_check_init_makes) {
+  const DpSlamOptions b = test::sim_options(5);
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  char why[240];
+  CHECK_TRUE(SdpSlam::check_options(b, s, why, sizeof why));
+  STRCMP_EQUAL("", why);
+  {
+    std::vector<unsigned char> buffer(SdpSlam::required_arena_bytes(b, s));
+    Arena arena(buffer.data(), buffer.size());
+    SdpSlam slam;
+    CHECK_TRUE(slam.init(b, s, arena, 1));
+  }
+  DpSlamOptions wide = b;
+  wide.map_width_m = 3000.0;  // 60000 cells of 5 cm: beyond loop closure's 16-bit cell coordinates
+  CHECK_FALSE(SdpSlam::check_options(wide, s, why, sizeof why));
+  CHECK(std::strncmp(why, "map.width_m: a map grid 60000 cells wide", 40) == 0);
+  test::SdpRig rig;
+  CHECK_FALSE(rig.init(wide, s, 1));
+  STRCMP_EQUAL(why, rig.slam->why());
+  s.loop_closure = false;  // the limit is loop closure's
+  CHECK_TRUE(SdpSlam::check_options(wide, s, why, sizeof why));
+  s.skeleton_max_side_m = 400.0;
+  CHECK_FALSE(SdpSlam::check_options(b, s, why, sizeof why));
+  CHECK(std::strncmp(why, "sdp.skeleton_max_side_m: ", 25) == 0);
+  s = test::small_sdp_options();
+  s.top_particles = 0U;
+  CHECK_FALSE(SdpSlam::check_options(b, s, nullptr, 0U));  // why may be null
+}
+
 TEST(SdpSlam, a_long_run_fills_the_pgs_and_makes_old_levels_permanent) {
   const test::ScanSet set(3);
   test::SdpRig rig;

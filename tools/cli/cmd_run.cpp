@@ -12,6 +12,7 @@
 #include <string>
 
 #include "cli_common.h"
+#include "sdpslam/slam/config_ini.h"
 #include "sdpslam/slam/run_offline.h"
 #include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/run_sdp.h"
@@ -125,10 +126,9 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
       return report("", kExitUsage, error);
     }
   }
-  char why[200];
-  if (!ro.config.filter.validate(why, sizeof why) || !ro.sdp.validate(why, sizeof why)) {
-    return report("", kExitUsage, why);
-  }
+  // Every check the core makes at init, before any work: a refusal names the key (and
+  // the config's line that set it).
+  if (!slam::sdp_check_options(ro, &error)) return report("", kExitUsage, slam::locate_option_error(a.config, error));
   if (const int rc = check_memory_budget(a, slam::sdp_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }
@@ -161,7 +161,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   ro.config = config;
   if (a.particles != 0U) ro.config.filter.particle_count = a.particles;
   char why[200];
-  if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, why);
+  if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, slam::locate_option_error(a.config, why));
   if (const int rc = check_memory_budget(a, slam::dpslam_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }

@@ -292,13 +292,19 @@ std::size_t sdp_state_bytes(const SdpRunOptions& options) {
   return SdpSlam::required_arena_bytes(options.config.filter, options.sdp);
 }
 
+bool sdp_check_options(const SdpRunOptions& options, std::string* why) {
+  char text[240];
+  if (SdpSlam::check_options(options.config.filter, options.sdp, text, sizeof text)) return true;
+  *why = text;
+  return false;
+}
+
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error) {
   const auto t_start = std::chrono::steady_clock::now();
   const DpSlamOptions& fo = options.config.filter;
-  char why[200];
-  if (!fo.validate(why, sizeof why) || !options.sdp.validate(why, sizeof why)) {
-    *error = std::string("invalid options: ") + why;
+  if (std::string why; !sdp_check_options(options, &why)) {
+    *error = "invalid options: " + why;
     return SdpRunStatus::kBadInput;
   }
   io::LogReader reader;

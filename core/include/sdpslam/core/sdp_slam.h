@@ -174,9 +174,17 @@ class SdpSlam {
   // The bottom options SDP-SLAM actually uses: `bottom` plus the pool room anchored
   // segments need (extra ancestry nodes and path entries for max_levels segments).
   static DpSlamOptions bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp);
+  // Every check init() makes of the options, without an arena: each option's range
+  // (SdpOptions::validate, and DpSlamOptions::validate of bottom_options_for()) and the
+  // limits that join options (the skeleton patch, the cell coordinates of loop
+  // closure's obstacle points). Options that pass start: init()
+  // refuses them only for an arena smaller than required_arena_bytes(). `why` (may be
+  // null) gets "section.key: reason" naming the key to change.
+  static bool check_options(const DpSlamOptions& bottom, const SdpOptions& sdp, char* why, std::size_t n);
   // Arena bytes init() needs (0 iff the options are invalid).
   static std::size_t required_arena_bytes(const DpSlamOptions& bottom, const SdpOptions& sdp);
-  // False iff options are invalid or the arena too small (why() says which). Call once.
+  // False iff check_options() refuses the options or the arena is too small (why() says
+  // which). Call once.
   bool init(const DpSlamOptions& bottom, const SdpOptions& sdp, Arena& arena, std::uint64_t seed);
   const char* why() const { return why_; }
 

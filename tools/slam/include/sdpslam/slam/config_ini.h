@@ -35,6 +35,12 @@ bool load_config_ini(std::FILE* stream, const std::string& name, SlamConfig* con
 // built-in defaults would run unannounced). Files, pipes and /dev/null are accepted.
 std::FILE* open_config_file(const std::string& path, std::string* error);
 
+// An option refused after the file was read (a check that joins keys, or one the
+// command line set) is named as "section.key: reason" (DpSlamOptions / SdpOptions
+// validate, SdpSlam::check_options). Returns "path:LINE: " + why when `path` sets that
+// key (LINE its line), else `why` unchanged: the user is sent to the line to change.
+std::string locate_option_error(const std::string& path, const std::string& why);
+
 // The line source of every INI reader above, for inih's ini_parse_stream (an ini_reader
 // with the stream passed separately). inih reads with fgets into a buffer of `num` bytes
 // and parses each piece as a line of its own, so a longer line would be cut: its first

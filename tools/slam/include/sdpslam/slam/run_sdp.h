@@ -66,6 +66,9 @@ enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };
 // allocates: SdpSlam::required_arena_bytes), known before any work; 0 when the options
 // are invalid or their sizes overflow.
 std::size_t sdp_state_bytes(const SdpRunOptions& options);
+// Whether the core starts with these options (SdpSlam::check_options: every check of
+// init but the arena's size); false with *why = "section.key: reason" otherwise.
+bool sdp_check_options(const SdpRunOptions& options, std::string* why);
 
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error);
