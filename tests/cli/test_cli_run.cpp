@@ -363,6 +363,30 @@ TEST(CliRun, a_state_above_the_memory_budget_is_refused_before_any_work) {
   CHECK_EQUAL(-1, ::stat((dir + "/c").c_str(), &st));
 }
 
+// `convert` keeps every good record of a log with bad lines, names the bad ones, and
+// refuses a log with no scan and no odometry left (its lines all malformed) instead of
+// writing an empty log with exit 0.
+TEST(CliRun, convert_refuses_a_log_with_nothing_left_and_writes_nothing) {
+  std::string text;
+  for (int i = 0; i < 3; ++i) text += scan(0.5, 101.0 + 0.1 * i, "nan");
+  text += "NOSUCHSENSOR 1 2 3\n";
+  const std::string bad = put("bad.clf", text);
+  Run r = run_cli("convert --quiet " + bad + " " + dir + "/bad_out.clf");
+  LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
+  STRCMP_CONTAINS((bad + ":1: range 7 (field 10) is not a finite number").c_str(), r.out.c_str());
+  STRCMP_CONTAINS((bad + ": no laser scan and no odometry in 4 lines (4 skipped): nothing to convert").c_str(),
+                  r.out.c_str());
+  struct stat st {};
+  CHECK_EQUAL(-1, ::stat((dir + "/bad_out.clf").c_str(), &st));
+  // The same bad lines after good scans: the good ones are converted, exit 0.
+  const std::string mixed = log_with_bad_lines(3);
+  r = run_cli("convert --quiet " + mixed + " " + dir + "/mixed_out.clf");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("10 scans", r.out.c_str());
+  STRCMP_CONTAINS("warning: 4 input lines skipped", r.out.c_str());
+  LONGS_EQUAL(10, lines_in(dir + "/mixed_out.clf"));
+}
+
 // What the core would refuse at init is refused before any work, with the config line
 // that set the key (SdpSlam::check_options: limits that join several options).
 TEST(CliRun, options_the_core_cannot_start_with_are_refused_at_their_line_before_any_work) {

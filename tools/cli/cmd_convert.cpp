@@ -1,6 +1,7 @@
 // `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz)
 // to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
-// skipped and listed ("file:line: reason"), never fatal.
+// skipped and listed ("file:line: reason"); an input with no scan and no odometry left
+// is refused (exit 3) and OUT is not written.
 
 #include <cstdio>
 #include <memory>
@@ -77,6 +78,13 @@ int run_convert(const ConvertArgs& a) {
   progress.finish();
 
   io::write_log_errors(stderr, reader.errors(), reader.error_count(), kLogErrorsShown);
+  // A log with no scan and no odometry left has nothing a log is for: refused, and OUT
+  // is not written (the writer's temporary file is abandoned), whatever else it held.
+  if (lasers == 0U && odoms == 0U) {
+    std::fprintf(stderr, "sdpslam convert: %s: no laser scan and no odometry in %lld lines (%zu skipped): nothing to convert\n",
+                 a.in.c_str(), static_cast<long long>(reader.lines_read()), reader.error_count());
+    return kExitBadInput;
+  }
   if (!writer.close(&error)) {
     std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
     return kExitIo;
