@@ -363,6 +363,17 @@ TEST(CliRun, a_state_above_the_memory_budget_is_refused_before_any_work) {
   CHECK_EQUAL(-1, ::stat((dir + "/c").c_str(), &st));
 }
 
+// fopen() opens a directory, and reading one looks like an empty file: the built-in
+// defaults would run unannounced.
+TEST(CliRun, a_directory_given_as_the_config_is_refused_before_any_work) {
+  const std::string log = log_with_bad_lines(0);
+  const Run r = run_cli("run " + log + " --config " + dir + " --out " + dir + "/a");
+  LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
+  STRCMP_CONTAINS(("sdpslam run: " + dir + ": is a directory, not a configuration file").c_str(), r.out.c_str());
+  struct stat st {};
+  CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));
+}
+
 // `convert` keeps every good record of a log with bad lines, names the bad ones, and
 // refuses a log with no scan and no odometry left (its lines all malformed) instead of
 // writing an empty log with exit 0.

@@ -2,6 +2,7 @@
 #include <CppUTest/TestHarness.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 
@@ -278,6 +279,35 @@ TEST(SdpslamdConfig, the_units_memory_ceiling_is_above_the_default_state_budget)
   std::fclose(f);
   const DaemonConfig defaults;
   CHECK_TEXT(max_mib >= 2L * defaults.memory_budget_mib, "MemoryMax= missing or below twice the state budget");
+}
+
+// The unit names no device (the config does, and sdpslamd waits for each), so a robot
+// with can1 or a late USB adapter needs no drop-in; its device policy lets every serial
+// UART a robot computer has through: USB adapters, PC UARTs, the Raspberry Pi's (ttyAMA)
+// and the Jetson's (ttyTHS).
+TEST(SdpslamdConfig, the_unit_names_no_device_and_allows_the_uarts_of_robot_computers) {
+  std::string unit = SDPSLAMD_EXAMPLE_INI;
+  unit = unit.substr(0, unit.rfind('/')) + "/systemd/sdpslamd.service";
+  std::FILE* f = std::fopen(unit.c_str(), "r");
+  CHECK_TEXT(f != nullptr, unit.c_str());
+  char line[256];
+  std::string allowed;
+  while (std::fgets(line, sizeof line, f) != nullptr) {
+    const std::string l(line);
+    if (l.empty() || l[0] == '#') continue;
+    for (const char* dep : {"After=", "Wants=", "Requires=", "BindsTo=", "PartOf="}) {
+      if (l.compare(0, std::strlen(dep), dep) == 0) {
+        CHECK_TEXT(l.find("can") == std::string::npos && l.find("dev-") == std::string::npos &&
+                       l.find("sys-subsystem") == std::string::npos,
+                   l.c_str());
+      }
+    }
+    if (l.compare(0, 12, "DeviceAllow=") == 0) allowed += l;
+  }
+  std::fclose(f);
+  for (const char* uart : {"char-ttyACM rw", "char-ttyUSB rw", "char-ttyS rw", "char-ttyAMA rw", "char-ttyTHS rw"}) {
+    CHECK_TEXT(allowed.find(uart) != std::string::npos, uart);
+  }
 }
 
 // Either would make the file mean what its last occurrence says.
