@@ -269,8 +269,12 @@ bool Daemon::write_outputs() {
     last_output_error_ = error;
     log_.log(Event::kOutput, "write failed, previous files kept: %s", error.c_str());
   }
+  // The heartbeat is rewritten every period and replaced by the next one: atomic (a
+  // reader sees one whole file), not flushed to storage each time, so an idle daemon
+  // makes no fsync at all.
   std::string status_error;
-  if (!io::write_file_atomic(config_.output_directory + "/status.json", status_json(), &status_error)) {
+  if (!io::write_file_atomic(config_.output_directory + "/status.json", status_json(), &status_error,
+                             io::Sync::kAtomicOnly)) {
     ++counters_.output_failures;
     last_output_error_ = status_error;
     log_.log(Event::kOutput, "write failed, previous file kept: %s", status_error.c_str());

@@ -56,6 +56,21 @@ TEST(AtomicFile, write_replaces_existing_target_and_leaves_no_temporary) {
   STRCMP_EQUAL("out.txt", names[0].c_str());
 }
 
+// kDurable flushes the file and its directory to storage (two fsyncs); kAtomicOnly
+// replaces the file the same way (one whole file, no temporary left) without either.
+TEST(AtomicFile, atomic_only_replaces_the_same_way_without_flushing_to_storage) {
+  std::string error;
+  const std::string path = dir + "/status.json";
+  std::uint64_t before = sdpslam::io::fsync_count();
+  CHECK_TRUE(sdpslam::io::write_file_atomic(path, "{\"a\": 1}\n", &error));
+  UNSIGNED_LONGLONGS_EQUAL(before + 2U, sdpslam::io::fsync_count());
+  before = sdpslam::io::fsync_count();
+  CHECK_TRUE(sdpslam::io::write_file_atomic(path, "{\"a\": 2}\n", &error, sdpslam::io::Sync::kAtomicOnly));
+  UNSIGNED_LONGLONGS_EQUAL(before, sdpslam::io::fsync_count());
+  STRCMP_EQUAL("{\"a\": 2}\n", read_file(path).c_str());
+  LONGS_EQUAL(1, list_dir(dir).size());
+}
+
 TEST(AtomicFile, empty_contents_give_an_empty_file) {
   std::string error;
   const std::string path = dir + "/empty";

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sdpslam/daemon/daemon.h"
+#include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "shared_data.h"
 
@@ -345,13 +346,17 @@ TEST(SdpslamdLoop, idle_periods_rewrite_nothing_and_the_set_has_a_manifest) {
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(1, r.d->counters().output_writes);
   CHECK_TRUE(file_exists(r.config.output_directory + "/manifest.txt"));
+  const std::uint64_t fsyncs = io::fsync_count();
   CHECK_TRUE(r.d->write_outputs());
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(1, r.d->counters().output_writes);
   LONGS_EQUAL(2, r.d->counters().output_writes_unchanged);
+  UNSIGNED_LONGLONGS_EQUAL(fsyncs, io::fsync_count());  // idle: nothing flushed to storage
+  CHECK_TRUE(file_exists(r.config.output_directory + "/status.json"));  // the heartbeat still is written
   r.scan_between_odometry(100, 1100000);
   CHECK_TRUE(r.d->write_outputs());
   LONGS_EQUAL(2, r.d->counters().output_writes);
+  CHECK(io::fsync_count() > fsyncs);  // a new set is made durable
   std::vector<io::StampedPose> t;
   std::string error;
   CHECK_TRUE(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error));

@@ -18,6 +18,12 @@ namespace {
 
 // Distinguishes temporaries opened by the same process (several outputs at once).
 std::atomic<unsigned long> g_temp_counter{0};
+std::atomic<std::uint64_t> g_fsyncs{0};
+
+int counted_fsync(int fd) {
+  g_fsyncs.fetch_add(1U, std::memory_order_relaxed);
+  return ::fsync(fd);
+}
 
 void set_error(std::string* error, const std::string& what, const std::string& path, int err) {
   if (error != nullptr) *error = what + " '" + path + "': " + std::strerror(err);
@@ -40,6 +46,8 @@ void split_path(const std::string& path, std::string* dir, std::string* base) {
 
 }  // namespace
 
+std::uint64_t fsync_count() { return g_fsyncs.load(std::memory_order_relaxed); }
+
 bool fsync_directory(const std::string& dir, std::string* error) {
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0) {
@@ -47,7 +55,7 @@ bool fsync_directory(const std::string& dir, std::string* error) {
     return false;
   }
   bool ok = true;
-  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+  if (counted_fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
     set_error(error, "fsync failed on directory", dir, errno);
     ok = false;
   }
@@ -99,7 +107,7 @@ bool AtomicOutputFile::open(const std::string& path, std::string* error) {
   return true;
 }
 
-bool AtomicOutputFile::commit(std::string* error) {
+bool AtomicOutputFile::commit(std::string* error, Sync sync) {
   if (file_ == nullptr) {
     if (error != nullptr) *error = "cannot commit '" + path_ + "': no file is open";
     return false;
@@ -112,7 +120,7 @@ bool AtomicOutputFile::commit(std::string* error) {
   } else if (std::fflush(file_) != 0) {
     err = write_errno_ != 0 ? write_errno_ : errno;
     what = "a write failed on";
-  } else if (::fsync(fd_) != 0) {
+  } else if (sync == Sync::kDurable && counted_fsync(fd_) != 0) {
     err = errno;
     what = "fsync failed on";
   }
@@ -133,6 +141,7 @@ bool AtomicOutputFile::commit(std::string* error) {
     return false;
   }
   temp_path_.clear();
+  if (sync == Sync::kAtomicOnly) return true;
   std::string dir;
   std::string base;
   split_path(path_, &dir, &base);
@@ -173,7 +182,7 @@ void AtomicOutputFile::abandon() {
   }
 }
 
-bool write_file_atomic(const std::string& path, const std::string& contents, std::string* error) {
+bool write_file_atomic(const std::string& path, const std::string& contents, std::string* error, Sync sync) {
   AtomicOutputFile out;
   if (!out.open(path, error)) return false;
   if (!contents.empty() && std::fwrite(contents.data(), 1, contents.size(), out.stream()) != contents.size()) {
@@ -182,7 +191,7 @@ bool write_file_atomic(const std::string& path, const std::string& contents, std
     set_error(error, "write failed on", path, err);
     return false;
   }
-  return out.commit(error);
+  return out.commit(error, sync);
 }
 
 bool make_directories(const std::string& dir, std::string* error) {
