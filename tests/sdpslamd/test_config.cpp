@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "sdpslam/daemon/daemon_config.h"
 #include "sdpslam/daemon/slam_engine.h"
@@ -264,19 +265,24 @@ TEST(SdpslamdConfig, a_binary_file_is_refused_without_echoing_its_bytes) {
   for (const char ch : error) CHECK_TEXT(static_cast<unsigned char>(ch) >= 0x20 && ch != 0x7F, error.c_str());
 }
 
+// The lines of the shipped systemd unit (firmware-host/systemd/sdpslamd.service).
+std::vector<std::string> unit_lines() {
+  std::string unit = SDPSLAMD_EXAMPLE_INI;
+  unit = unit.substr(0, unit.rfind('/')) + "/systemd/sdpslamd.service";
+  std::ifstream in(unit);
+  CHECK_TEXT(in.good(), unit.c_str());
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
 // The unit's MemoryMax= sits above the default budget of the state, with room for the
 // rest of the process.
 TEST(SdpslamdConfig, the_units_memory_ceiling_is_above_the_default_state_budget) {
-  std::string unit = SDPSLAMD_EXAMPLE_INI;
-  unit = unit.substr(0, unit.rfind('/')) + "/systemd/sdpslamd.service";
-  std::FILE* f = std::fopen(unit.c_str(), "r");
-  CHECK_TEXT(f != nullptr, unit.c_str());
-  char line[256];
   long max_mib = 0;
-  while (std::fgets(line, sizeof line, f) != nullptr) {
-    if (std::sscanf(line, "MemoryMax=%ldM", &max_mib) == 1) break;
+  for (const std::string& line : unit_lines()) {
+    if (std::sscanf(line.c_str(), "MemoryMax=%ldM", &max_mib) == 1) break;
   }
-  std::fclose(f);
   const DaemonConfig defaults;
   CHECK_TEXT(max_mib >= 2L * defaults.memory_budget_mib, "MemoryMax= missing or below twice the state budget");
 }
@@ -286,14 +292,8 @@ TEST(SdpslamdConfig, the_units_memory_ceiling_is_above_the_default_state_budget)
 // UART a robot computer has through: USB adapters, PC UARTs, the Raspberry Pi's (ttyAMA)
 // and the Jetson's (ttyTHS).
 TEST(SdpslamdConfig, the_unit_names_no_device_and_allows_the_uarts_of_robot_computers) {
-  std::string unit = SDPSLAMD_EXAMPLE_INI;
-  unit = unit.substr(0, unit.rfind('/')) + "/systemd/sdpslamd.service";
-  std::FILE* f = std::fopen(unit.c_str(), "r");
-  CHECK_TEXT(f != nullptr, unit.c_str());
-  char line[256];
   std::string allowed;
-  while (std::fgets(line, sizeof line, f) != nullptr) {
-    const std::string l(line);
+  for (const std::string& l : unit_lines()) {
     if (l.empty() || l[0] == '#') continue;
     for (const char* dep : {"After=", "Wants=", "Requires=", "BindsTo=", "PartOf="}) {
       if (l.compare(0, std::strlen(dep), dep) == 0) {
@@ -304,7 +304,6 @@ TEST(SdpslamdConfig, the_unit_names_no_device_and_allows_the_uarts_of_robot_comp
     }
     if (l.compare(0, 12, "DeviceAllow=") == 0) allowed += l;
   }
-  std::fclose(f);
   for (const char* uart : {"char-ttyACM rw", "char-ttyUSB rw", "char-ttyS rw", "char-ttyAMA rw", "char-ttyTHS rw"}) {
     CHECK_TEXT(allowed.find(uart) != std::string::npos, uart);
   }
