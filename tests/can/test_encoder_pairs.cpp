@@ -512,3 +512,61 @@ TEST(EncoderBacklog, backlog_read_frame_by_frame_keeps_both_wheels_fresh) {
   enc.update();
   CHECK_FALSE(enc.latest().both_fresh());
 }
+
+namespace {
+// A bus that is down (interface gone or bus-off): every send is refused, nothing arrives.
+// It counts the refusals itself (SocketCanBus: CanBusStats::tx_while_down).
+class DownBus final : public hal::CanBus {
+ public:
+  int send(const hal::CanFrame&) override {
+    ++refused;
+    return -1;
+  }
+  int receive(hal::CanFrame&) override { return 0; }
+  int wait_readable(std::int64_t) override { return 0; }
+  hal::CanBusState state() const override { return hal::CanBusState::kDown; }
+  const hal::CanBusStats& stats() const override { return stats_; }
+  int refused = 0;
+
+ private:
+  hal::CanBusStats stats_{};
+};
+}  // namespace
+
+// While the bus is down the encoder pairs keep trying (SYNC, NMT start, RTR requests on
+// their schedules) but count no transmit error: the outage is the bus's event, counted
+// once there, not one error per retry (hundreds a second).
+TEST_GROUP(EncoderPairsOnADownBus) {
+  test::FakeClock clock;
+  DownBus bus;
+};
+
+TEST(EncoderPairsOnADownBus, canopen_retries_count_no_transmit_error) {
+  CanOpenEncoderOptions o = canopen_options();
+  o.sync_period_us = 10000;
+  o.send_nmt_start = true;
+  CanOpenEncoderPair enc(bus, clock, o);
+  CHECK(enc.start() < 0);
+  for (int i = 0; i < 100; ++i) {
+    clock.t_us += 10000;
+    enc.update();
+  }
+  CHECK(bus.refused >= 100);  // it did keep trying
+  LONGS_EQUAL(0, enc.stats().tx_errors);
+  LONGS_EQUAL(0, enc.stats().sync_sent);
+}
+
+TEST(EncoderPairsOnADownBus, odrive_retries_count_no_transmit_error) {
+  ODriveEncoderOptions o;
+  o.left_node = 1;
+  o.right_node = 2;
+  o.request_period_us = 10000;
+  ODriveEncoderPair enc(bus, clock, o);
+  for (int i = 0; i < 100; ++i) {
+    clock.t_us += 10000;
+    enc.update();
+  }
+  CHECK(bus.refused >= 100);
+  LONGS_EQUAL(0, enc.stats().tx_errors);
+  LONGS_EQUAL(0, enc.stats().requests_sent);
+}
