@@ -514,7 +514,7 @@ TEST(EncoderBacklog, backlog_read_frame_by_frame_keeps_both_wheels_fresh) {
 }
 
 namespace {
-// A bus that is down (interface gone or bus-off): every send is refused, nothing arrives.
+// A bus that is down (its interface missing or down): every send is refused, nothing arrives.
 // It counts the refusals itself (SocketCanBus: CanBusStats::tx_while_down).
 class DownBus final : public hal::CanBus {
  public:
