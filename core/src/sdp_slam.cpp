@@ -137,27 +137,29 @@ bool SdpSlam::check_options(const DpSlamOptions& bottom, const SdpOptions& s, ch
     }
     return false;
   }
-  auto refuse = [why, n](const char* text, double a, double c) {
-    if (why != nullptr && n > 0U) std::snprintf(why, n, text, a, c);
-    return false;
-  };
   static_assert(capacity::kMaxPgsNodesPerLevel >= capacity::kMaxBottomParticles,
                 "every bottom particle count validate() accepts has its PGS node");
   const std::uint32_t coarse = coarse_side_cells(b, s);
   if (coarse > capacity::kMaxSkeletonPatchSide) {
-    return refuse("sdp.skeleton_max_side_m: a skeleton patch of %.0f cells, above the %.0f cells it may have "
-                  "(raise [sdp] skeleton_downsample or [map] resolution_m)",
-                  coarse, capacity::kMaxSkeletonPatchSide);
+    if (why != nullptr && n > 0U) {
+      std::snprintf(why, n,
+                    "sdp.skeleton_max_side_m: a skeleton patch of %u cells, above the %u cells it may have "
+                    "(raise [sdp] skeleton_downsample or [map] resolution_m)",
+                    coarse, capacity::kMaxSkeletonPatchSide);
+    }
+    return false;
   }
   // Loop closure keeps obstacle points as 16-bit cell coordinates of the map grid.
-  const double cells = (b.map_width_m > b.map_height_m ? b.map_width_m : b.map_height_m) / b.map_resolution_m;
+  const bool wide = b.map_width_m >= b.map_height_m;
+  const double cells = (wide ? b.map_width_m : b.map_height_m) / b.map_resolution_m;
   if (s.loop_closure && cells > 32767.0) {
-    return refuse(b.map_width_m >= b.map_height_m
-                      ? "map.width_m: a map grid %.0f cells wide, above the %.0f that loop closure's cell "
-                        "coordinates hold (lower [map] width_m/height_m or raise resolution_m)"
-                      : "map.height_m: a map grid %.0f cells high, above the %.0f that loop closure's cell "
-                        "coordinates hold (lower [map] width_m/height_m or raise resolution_m)",
-                  cells, 32767.0);
+    if (why != nullptr && n > 0U) {
+      std::snprintf(why, n,
+                    "map.%s: a map grid %.0f cells %s, above the 32767 that loop closure's cell coordinates hold "
+                    "(lower [map] width_m/height_m or raise resolution_m)",
+                    wide ? "width_m" : "height_m", cells, wide ? "wide" : "high");
+    }
+    return false;
   }
   return true;
 }

@@ -27,6 +27,14 @@ CanOpenEncoderOptions canopen_options() {
   o.position_timeout_us = 50000;
   return o;
 }
+// Two axes, nodes 1 and 2, estimates requested every 10 ms.
+ODriveEncoderOptions odrive_request_options() {
+  ODriveEncoderOptions o;
+  o.left_node = 1;
+  o.right_node = 2;
+  o.request_period_us = 10000;
+  return o;
+}
 }  // namespace
 
 TEST_GROUP(CanOpenEncoderPair) {
@@ -326,11 +334,7 @@ TEST(ODriveEncoderPair, estimates_become_ticks_at_counts_per_turn) {
 }
 
 TEST(ODriveEncoderPair, rtr_requests_follow_the_period) {
-  ODriveEncoderOptions o;
-  o.left_node = 1;
-  o.right_node = 2;
-  o.request_period_us = 10000;
-  ODriveEncoderPair enc(*bus, clock, o);
+  ODriveEncoderPair enc(*bus, clock, odrive_request_options());
   enc.update();
   clock.t_us += 9999;
   enc.update();
@@ -557,11 +561,7 @@ TEST(EncoderPairsOnADownBus, canopen_retries_count_no_transmit_error) {
 }
 
 TEST(EncoderPairsOnADownBus, odrive_retries_count_no_transmit_error) {
-  ODriveEncoderOptions o;
-  o.left_node = 1;
-  o.right_node = 2;
-  o.request_period_us = 10000;
-  ODriveEncoderPair enc(bus, clock, o);
+  ODriveEncoderPair enc(bus, clock, odrive_request_options());
   for (int i = 0; i < 100; ++i) {
     clock.t_us += 10000;
     enc.update();

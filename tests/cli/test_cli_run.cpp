@@ -340,11 +340,7 @@ TEST(CliRun, numbers_out_of_range_and_an_empty_output_folder_are_usage_errors) {
 // for, and nothing is written.
 TEST(CliRun, a_state_above_the_memory_budget_is_refused_before_any_work) {
   const std::string log = log_with_bad_lines(0);
-  const std::string ini = dir + "/huge.ini";
-  {
-    std::ofstream f(ini);
-    f << "[sdp]\nmap_observation_capacity = 1000000000\n";
-  }
+  const std::string ini = put("huge.ini", "[sdp]\nmap_observation_capacity = 1000000000\n");
   Run r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
   LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
   STRCMP_CONTAINS("the SLAM state needs ", r.out.c_str());
@@ -402,20 +398,13 @@ TEST(CliRun, convert_refuses_a_log_with_nothing_left_and_writes_nothing) {
 // that set the key (SdpSlam::check_options: limits that join several options).
 TEST(CliRun, options_the_core_cannot_start_with_are_refused_at_their_line_before_any_work) {
   const std::string log = log_with_bad_lines(0);
-  const std::string ini = dir + "/wide.ini";
-  {
-    std::ofstream f(ini);
-    f << "[filter]\nparticles = 10\n\n[map]\nwidth_m = 3000\n";
-  }
+  std::string ini = put("wide.ini", "[filter]\nparticles = 10\n\n[map]\nwidth_m = 3000\n");
   Run r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
   LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
   STRCMP_CONTAINS((ini + ":5: map.width_m: a map grid 60000 cells wide").c_str(), r.out.c_str());
   struct stat st {};
   CHECK_EQUAL(-1, ::stat((dir + "/a").c_str(), &st));  // nothing ran, no folder made
-  {
-    std::ofstream f(ini);
-    f << "[sdp]\nskeleton_max_side_m = 400\n";
-  }
+  ini = put("patch.ini", "[sdp]\nskeleton_max_side_m = 400\n");
   r = run_cli("run " + log + " --config " + ini + " --out " + dir + "/a");
   LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
   STRCMP_CONTAINS((ini + ":2: sdp.skeleton_max_side_m: a skeleton patch of").c_str(), r.out.c_str());

@@ -81,7 +81,9 @@ int run_convert(const ConvertArgs& a) {
   // A log with no scan and no odometry left has nothing a log is for: refused, and OUT
   // is not written (the writer's temporary file is abandoned), whatever else it held.
   if (lasers == 0U && odoms == 0U) {
-    std::fprintf(stderr, "sdpslam convert: %s: no laser scan and no odometry in %lld lines (%zu skipped): nothing to convert\n",
+    std::fprintf(stderr,
+                 "sdpslam convert: %s: no laser scan and no odometry in %lld lines (%zu skipped): nothing to "
+                 "convert\n",
                  a.in.c_str(), static_cast<long long>(reader.lines_read()), reader.error_count());
     return kExitBadInput;
   }

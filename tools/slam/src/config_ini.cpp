@@ -289,42 +289,49 @@ std::FILE* open_config_file(const std::string& path, std::string* error) {
   return f;
 }
 
+namespace {
+
+// The line that sets [section] key, found by inih as every reader here parses (0: none).
+struct KeyLine {
+  std::FILE* stream = nullptr;
+  std::string section;
+  std::string key;
+  int line = 0;
+  int found = 0;
+};
+
+char* key_line_read(char* str, int num, void* user) {
+  auto* k = static_cast<KeyLine*>(user);
+  std::string ignored;
+  char* r = read_ini_line(k->stream, str, num, &ignored);
+  if (r != nullptr) ++k->line;
+  return r;
+}
+
+int key_line_handler(void* user, const char* section, const char* name, const char*) {
+  auto* k = static_cast<KeyLine*>(user);
+  if (k->found == 0 && name != nullptr && k->section == section && k->key == name) k->found = k->line;
+  return 1;
+}
+
+}  // namespace
+
 std::string locate_option_error(const std::string& path, const std::string& why) {
   const std::size_t dot = why.find('.');
   const std::size_t colon = why.find(':');
   if (path.empty() || dot == std::string::npos || colon == std::string::npos || dot > colon) return why;
-  const std::string section = why.substr(0, dot);
   std::size_t end = dot + 1U;
   while (end < colon && (std::isalnum(static_cast<unsigned char>(why[end])) != 0 || why[end] == '_')) ++end;
-  const std::string key = why.substr(dot + 1U, end - dot - 1U);
-  if (key.empty()) return why;
+  KeyLine k;
+  k.section = why.substr(0, dot);
+  k.key = why.substr(dot + 1U, end - dot - 1U);
+  if (k.key.empty()) return why;
   std::string ignored;
-  std::FILE* f = open_config_file(path, &ignored);
-  if (f == nullptr) return why;
-  auto trim = [](std::string t) {
-    const std::size_t b = t.find_first_not_of(" \t\r\n");
-    if (b == std::string::npos) return std::string();
-    return t.substr(b, t.find_last_not_of(" \t\r\n") - b + 1U);
-  };
-  std::string current;
-  int line_no = 0;
-  int found = 0;
-  char line[INI_MAX_LINE];
-  std::string why_line;
-  while (found == 0 && read_ini_line(f, line, static_cast<int>(sizeof line), &why_line) != nullptr) {
-    ++line_no;
-    const std::string t = trim(line);
-    if (t.empty() || t[0] == ';' || t[0] == '#') continue;
-    if (t[0] == '[') {
-      const std::size_t close = t.find(']');
-      current = close == std::string::npos ? std::string() : trim(t.substr(1U, close - 1U));
-      continue;
-    }
-    const std::size_t eq = t.find_first_of("=:");
-    if (current == section && eq != std::string::npos && trim(t.substr(0U, eq)) == key) found = line_no;
-  }
-  std::fclose(f);
-  return found == 0 ? why : path + ":" + std::to_string(found) + ": " + why;
+  k.stream = open_config_file(path, &ignored);
+  if (k.stream == nullptr) return why;
+  (void)ini_parse_stream(key_line_read, &k, key_line_handler, &k);
+  std::fclose(k.stream);
+  return k.found == 0 ? why : path + ":" + std::to_string(k.found) + ": " + why;
 }
 
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
