@@ -58,6 +58,17 @@ bool InputRecorder::open(const std::string& path, std::string* error) {
   return true;
 }
 
+// A scan no CARMEN line can carry (the drivers produce none: 2..kMaxBeams beams, finite
+// poses): counted, and fed as it is.
+void InputRecorder::refuse(const OdometrySample& odom, const RangeScan& scan, OdometrySample* odom_out,
+                           RangeScan* scan_out) {
+  ++stats_.roundtrip_failures;
+  last_error_ = "input recording: the reader refuses the line of the scan at " + std::to_string(odom.stamp_us) +
+                " us: " + reason_;
+  *odom_out = odom;
+  *scan_out = scan;
+}
+
 bool InputRecorder::pass(const OdometrySample& odom, const RangeScan& scan, std::int64_t read_us,
                          OdometrySample* odom_out, RangeScan* scan_out) {
   ++stats_.scans;
@@ -68,23 +79,25 @@ bool InputRecorder::pass(const OdometrySample& odom, const RangeScan& scan, std:
   record_.odom_pose = odom.pose;
   record_.has_odom_pose = true;
   record_.has_laser_pose = false;
-  line_ = io::format_carmen_laser_line(record_);
-
-  const io::LogReader::Next k =
-      io::parse_carmen_line(line_, reader_options_, &parsed_, &odom_scratch_, &param_scratch_, &reason_);
-  if (k == io::LogReader::Next::kLaser) {
-    odom_out->stamp_us = parsed_.stamp_us;
-    odom_out->pose = parsed_.odom_pose;
-    *scan_out = parsed_.scan;
-  } else {
-    // Cannot happen for a scan the drivers produce (2..kMaxBeams beams, finite poses);
-    // counted rather than assumed.
-    ++stats_.roundtrip_failures;
-    last_error_ = "input recording: the reader refuses the line of the scan at " + std::to_string(odom.stamp_us) +
-                  " us: " + reason_;
-    odom_out->stamp_us = odom.stamp_us;
-    odom_out->pose = odom.pose;
-    *scan_out = scan;
+  // What SLAM gets is what the recording reads back as, recorded or not; it is computed
+  // without text (io::carmen_laser_round_trip) unless the numbers are so extreme that only
+  // the line can tell.
+  const io::CarmenRoundTrip k = io::carmen_laser_round_trip(record_, scan_out, &odom_out->pose);
+  odom_out->stamp_us = odom.stamp_us;
+  const bool text = file_ != nullptr || k == io::CarmenRoundTrip::kUnknown;
+  if (text) line_ = io::format_carmen_laser_line(record_);
+  if (k == io::CarmenRoundTrip::kUnknown) {
+    if (io::parse_carmen_line(line_, reader_options_, &parsed_, &odom_scratch_, &param_scratch_, &reason_) ==
+        io::LogReader::Next::kLaser) {
+      odom_out->stamp_us = parsed_.stamp_us;
+      odom_out->pose = parsed_.odom_pose;
+      *scan_out = parsed_.scan;
+    } else {
+      refuse(odom, scan, odom_out, scan_out);
+    }
+  } else if (k == io::CarmenRoundTrip::kRefused) {
+    reason_ = "no CARMEN line carries it (fewer than 2 beams, or a pose, laser configuration or stamp out of range)";
+    refuse(odom, scan, odom_out, scan_out);
   }
   if (!same_pose(odom_out->pose, odom.pose) || odom_out->stamp_us != odom.stamp_us || !same_scan(*scan_out, scan)) {
     ++stats_.changed_count;

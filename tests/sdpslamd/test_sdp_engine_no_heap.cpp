@@ -1,11 +1,14 @@
-// sdpslamd's SDP engine: once created, process() never touches the heap (the core's
-// guarantee plus the engine's own records, reserved at create time), across segments.
+// sdpslamd's per-scan path: once created, the SDP engine's process() never touches the heap
+// (the core's guarantee plus the engine's own records, reserved at create time), across
+// segments; and the input recorder that hands it each scan allocates nothing (and formats
+// no text) while no recording is open.
 #include <CppUTest/TestHarness.h>
 
 #include <cmath>
 #include <string>
 
 #include "alloc_counter.h"
+#include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/slam_engine.h"
 
 using sdpslam::daemon::DaemonConfig;
@@ -74,4 +77,26 @@ TEST(SdpEngineNoHeap, process_does_not_allocate_across_segmentations) {
   CHECK(at != std::string::npos);
   CHECK(std::stoul(status.substr(at + 25)) >= 1U);
   LONGS_EQUAL(120, static_cast<long>(engine->trajectory().size()));
+}
+
+TEST(SdpEngineNoHeap, the_input_recorder_allocates_nothing_while_not_recording) {
+  sdpslam::daemon::InputRecorder recorder;
+  static sdpslam::RangeScan scan;
+  static sdpslam::RangeScan fed;
+  scan.geometry.laser_in_base = sdpslam::Pose2{0.145, 0.0123, 0.1};  // a ROBOTLASER1 line
+  std::size_t allocations = 0U;
+  for (int k = 0; k < 50; ++k) {
+    box_scan(2.0 + 0.05 * k, 3.0, 1000000 + 100000LL * k, &scan);
+    scan.ranges_m[k] = k % 2 == 0 ? NAN : INFINITY;
+    const sdpslam::OdometrySample odom{scan.stamp_us, sdpslam::Pose2{0.05 * k, 0.0, 0.01 * k}};
+    sdpslam::OdometrySample fed_odom;
+    sdpslam::test::AllocationScope scope;
+    recorder.pass(odom, scan, scan.stamp_us + 5, &fed_odom, &fed);
+    allocations += scope.allocations();
+    LONGS_EQUAL(scan.stamp_us, fed.stamp_us);
+  }
+  LONGS_EQUAL(0, allocations);
+  LONGS_EQUAL(50, recorder.stats().scans);
+  LONGS_EQUAL(50, recorder.stats().changed_count);  // range_min, the NaN / inf beams, the mounting
+  LONGS_EQUAL(0, recorder.stats().roundtrip_failures);
 }

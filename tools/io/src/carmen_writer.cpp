@@ -38,6 +38,34 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
+// The writer's mapping of a beam: RangeScan allows NaN and negative values as invalid
+// beams and +inf as no return; the reader takes neither, so they are written as 0
+// (invalid) and range_max (no return).
+float carmen_range(float r, float range_max_m) {
+  if (std::isinf(r) && r > 0.0F && std::isfinite(range_max_m)) return range_max_m;
+  if (!std::isfinite(r) || r < 0.0F) return 0.0F;
+  return r;
+}
+
+// An upper bound on the characters detail::format_exact prints for a finite v (fixed
+// notation, the shortest digits that read back): sign, "0.", the zeros an exponent of
+// magnitude |e10| adds, and at most `digits` significant digits.
+std::size_t exact_width_bound(double v, int digits) {
+  if (v == 0.0) return 2U;
+  int e2 = 0;
+  (void)std::frexp(v, &e2);
+  const int e10 = (e2 < 0 ? -e2 : e2) * 30103 / 100000 + 2;
+  return static_cast<std::size_t>(3 + digits + e10);
+}
+
+bool finite_pose(const Pose2& p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.heading_rad); }
+
+// The reader takes at most 12 digits of seconds (detail::parse_stamp_us).
+bool stamp_fits(std::int64_t stamp_us) {
+  const std::uint64_t mag = stamp_us < 0 ? 0U - static_cast<std::uint64_t>(stamp_us) : static_cast<std::uint64_t>(stamp_us);
+  return mag / 1000000U < 1000000000000U;
+}
+
 // One line being formatted.
 struct LineBuilder {
   std::string line;
@@ -50,16 +78,7 @@ struct LineBuilder {
     line += detail::format_exact(v);
     line += ' ';
   }
-  // RangeScan allows NaN and negative values as invalid beams and +inf as no return; the
-  // reader takes neither, so they are written as 0 (invalid) and range_max (no return).
-  void range(float r, float range_max_m) {
-    if (std::isinf(r) && r > 0.0F && std::isfinite(range_max_m)) {
-      r = range_max_m;
-    } else if (!std::isfinite(r) || r < 0.0F) {
-      r = 0.0F;
-    }
-    numf(r);
-  }
+  void range(float r, float range_max_m) { numf(carmen_range(r, range_max_m)); }
   void pose(const Pose2& p) {
     num(p.x_m);
     num(p.y_m);
@@ -109,6 +128,56 @@ std::string format_carmen_laser_line(const LaserRecord& r) {
   }
   s.trailer(r.stamp_us, r.logger_stamp_us);
   return std::move(s.line);
+}
+
+CarmenRoundTrip carmen_laser_round_trip(const LaserRecord& r, RangeScan* scan, Pose2* odom_pose) {
+  const RangeScan& in = r.scan;
+  const ScanGeometry& g = in.geometry;
+  const std::uint32_t n = in.beam_count <= capacity::kMaxBeams ? in.beam_count : capacity::kMaxBeams;
+  Pose2 robot = r.odom_pose;  // as format_carmen_laser_line derives them
+  Pose2 laser_pose = r.laser_pose;
+  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
+  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
+  if (n < 2U || !finite_pose(robot) || !finite_pose(laser_pose) || !stamp_fits(r.stamp_us) ||
+      !stamp_fits(r.logger_stamp_us)) {
+    return CarmenRoundTrip::kRefused;
+  }
+  const bool flaser = fits_flaser(r);
+  const float fov = g.angle_increment_rad * static_cast<float>(n - 1U);
+  if (!flaser && (!std::isfinite(g.angle_min_rad) || !std::isfinite(fov) || !std::isfinite(g.angle_increment_rad) ||
+                  !std::isfinite(g.range_max_m) || !(g.range_max_m > 0.0F))) {
+    return CarmenRoundTrip::kRefused;
+  }
+  // The line's length: keyword, counts, constants and trailer in 128 characters, then
+  // every number at its widest.
+  std::size_t width = 128U;
+  for (std::uint32_t i = 0; i < n; ++i) width += exact_width_bound(carmen_range(in.ranges_m[i], g.range_max_m), 9) + 1U;
+  const double poses[6] = {laser_pose.x_m, laser_pose.y_m, laser_pose.heading_rad,
+                           robot.x_m,      robot.y_m,      robot.heading_rad};
+  for (double v : poses) width += exact_width_bound(v, 17) + 1U;
+  const float config[4] = {g.angle_min_rad, fov, g.angle_increment_rad, g.range_max_m};
+  for (float v : config) width += flaser ? 0U : exact_width_bound(v, 9) + 1U;
+  if (width > detail::kMaxLineBytes) return CarmenRoundTrip::kUnknown;
+
+  const LogReaderOptions defaults;  // what parse_flaser / parse_robotlaser set
+  for (std::uint32_t i = 0; i < n; ++i) scan->ranges_m[i] = carmen_range(in.ranges_m[i], g.range_max_m);
+  scan->beam_count = n;
+  scan->stamp_us = r.stamp_us;
+  ScanGeometry& out = scan->geometry;
+  out.range_min_m = 0.0F;
+  if (flaser) {
+    out.angle_min_rad = static_cast<float>(-kPi / 2.0);
+    out.angle_increment_rad = static_cast<float>(kPi / static_cast<double>(n - 1U));
+    out.range_max_m = defaults.front_laser_max_m > 0.0F ? defaults.front_laser_max_m : defaults.default_range_max_m;
+    out.laser_in_base = Pose2{defaults.front_laser_offset_m, 0.0, 0.0};
+  } else {
+    out.angle_min_rad = g.angle_min_rad;
+    out.angle_increment_rad = g.angle_increment_rad;
+    out.range_max_m = g.range_max_m;
+    out.laser_in_base = between(robot, laser_pose);
+  }
+  *odom_pose = robot;
+  return CarmenRoundTrip::kDone;
 }
 
 struct CarmenWriter::Impl {

@@ -8,19 +8,20 @@
 //
 // Exactness: a CARMEN line does not carry everything a RangeScan does (no range_min; the
 // mounting is rebuilt as between(robot pose, laser pose), which may differ in the last
-// bit; NaN / inf beams become 0 / range_max). So pass() always sends the scan through its
-// line and hands SLAM what a reader parses back (io::parse_carmen_line), whether or not a
-// file is being written: what SLAM sees does not depend on the switch, and the recording
-// holds exactly the values SLAM used. changed_count() says how many scans the round trip
-// altered at all (bitwise).
+// bit; NaN / inf beams become 0 / range_max). So pass() always hands SLAM what a reader
+// parses back from the scan's line, whether or not a file is being written: what SLAM sees
+// does not depend on the switch, and the recording holds exactly the values SLAM used.
+// Those values come from io::carmen_laser_round_trip, without formatting the line, so a
+// robot that does not record formats no text per scan. stats().changed_count says how many
+// scans the round trip altered at all (bitwise).
 //
 // Streaming: the file is created (truncated) by open() and each line is appended and
 // flushed as the scan is fed, so a recording survives a crash up to its last scan. It is
 // a record, not an output snapshot; it is not written atomically. A failed write is
 // counted and remembered (the scan is still processed; later lines are tried again).
 //
-// Memory: one RangeScan-sized record and one line buffer inside the object; the parse
-// allocates its field list per scan (host program, not the core).
+// Memory: one RangeScan-sized record and one line buffer inside the object. Without a
+// recording pass() allocates nothing; with one, the line is built in a std::string.
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -64,6 +65,8 @@ class InputRecorder {
   const std::string& path() const { return path_; }
 
  private:
+  void refuse(const OdometrySample& odom, const RangeScan& scan, OdometrySample* odom_out, RangeScan* scan_out);
+
   std::FILE* file_ = nullptr;
   std::string path_;
   std::string line_;

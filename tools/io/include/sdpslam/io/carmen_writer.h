@@ -15,6 +15,18 @@ namespace sdpslam::io {
 // for programs that stream a log line by line instead of writing it atomically.
 std::string format_carmen_laser_line(const LaserRecord& r);
 
+// What parse_carmen_line (default LogReaderOptions) reads back from
+// format_carmen_laser_line(r), computed from the numbers without formatting any text (the writer prints every number
+// so that it reads back exactly; what changes is the line's convention: no range_min, the
+// mounting rebuilt as between(robot pose, laser pose), NaN / +inf beams as 0 / range_max,
+// FLASER's fixed geometry). kDone: *scan (its stamp r.stamp_us) and *odom_pose are those
+// values. kRefused: the reader refuses the line (fewer than 2 beams, a pose, the laser
+// configuration or a stamp it cannot carry); the outputs are untouched. kUnknown: the line
+// may be longer than the reader's line limit (numbers of extreme magnitude), so only its
+// text can tell; the outputs are untouched.
+enum class CarmenRoundTrip { kDone, kRefused, kUnknown };
+CarmenRoundTrip carmen_laser_round_trip(const LaserRecord& r, RangeScan* scan, Pose2* odom_pose);
+
 class CarmenWriter {
  public:
   CarmenWriter();
