@@ -436,3 +436,45 @@ TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   STRCMP_CONTAINS("\"between\": 0, \"wrong\": 0", used.c_str());
   CHECK_TEXT(used.find("\"count\": 0,") == std::string::npos, used.c_str());
 }
+
+// `sdpslam localize` on a simulated world's own map, from the ground truth's first pose:
+// the path is the true one within centimetres, and the output set is complete.
+TEST(CliRun, localize_on_the_world_map_follows_the_true_path) {
+  Run r = run_cli("simulate --world paper --seed 1 --quiet --out " + dir + "/sim");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  std::ifstream gt(dir + "/sim/ground_truth.txt");
+  std::string line;
+  while (std::getline(gt, line) && line[0] == '#') {
+  }
+  std::istringstream first(line);
+  double t = 0.0, x = 0.0, y = 0.0, th = 0.0;
+  CHECK_TRUE(static_cast<bool>(first >> t >> x >> y >> th));
+  char start[96];
+  std::snprintf(start, sizeof start, "%.6f,%.6f,%.6f", x, y, th);
+  r = run_cli("localize " + dir + "/sim/sim.clf --map " + dir + "/sim/world.yaml --start " + start + " --quiet --out " +
+              dir + "/loc");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("converged at scan 0", r.out.c_str());
+  std::ifstream manifest(dir + "/loc/manifest.txt");
+  std::stringstream m;
+  m << manifest.rdbuf();
+  for (const char* name : {" trajectory.txt\n", " trajectory.tum\n", " map.png\n", " particles.tsv\n", " stats.json\n"}) {
+    STRCMP_CONTAINS(name, m.str().c_str());
+  }
+  LONGS_EQUAL(lines_in(dir + "/sim/ground_truth.txt"), lines_in(dir + "/loc/trajectory.txt"));
+  r = run_cli("evaluate --ground-truth " + dir + "/sim/ground_truth.txt --trajectory " + dir + "/loc/trajectory.txt");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  const std::size_t at = r.out.find("rmse ");
+  CHECK(at != std::string::npos);
+  CHECK_TEXT(std::stod(r.out.substr(at + 5)) < 0.05, r.out.c_str());
+}
+
+TEST(CliRun, localize_names_a_bad_start_and_a_missing_map) {
+  const std::string log = log_with_bad_lines(0);
+  Run r = run_cli("localize " + log + " --map " + dir + "/none.yaml --start 1,2 --out " + dir + "/loc");
+  LONGS_EQUAL(2, r.status);
+  STRCMP_CONTAINS("--start: expected x,y,theta", r.out.c_str());
+  r = run_cli("localize " + log + " --map " + dir + "/none.yaml --out " + dir + "/loc");
+  LONGS_EQUAL(3, r.status);
+  STRCMP_CONTAINS("none.yaml", r.out.c_str());
+}
