@@ -67,11 +67,17 @@ bool write_trajectories(const std::string& out_dir, const std::vector<io::Stampe
          io::write_trajectory_tum(out_dir + "/trajectory.tum", trajectory, error);
 }
 
+io::MapWriteOptions slam_map_thresholds() {
+  io::MapWriteOptions t;
+  t.occupied_thresh = kSlamOccupiedThreshold;
+  return t;
+}
+
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                               const io::OccupancyImage& image, std::string* error) {
   if (!write_trajectories(out_dir, trajectory, error)) return false;
   if (image.width > 0U) {
-    if (!io::write_map_pgm_yaml(out_dir + "/map", image, io::MapWriteOptions{}, error)) return false;
+    if (!io::write_map_pgm_yaml(out_dir + "/map", image, slam_map_thresholds(), error)) return false;
     if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return false;
   }
   return true;

@@ -50,9 +50,20 @@ std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* ima
 bool write_trajectories(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                         std::string* error);
 
+// The map's cells hold the share of the beams that reached them and ended there (hits /
+// (hits + misses), DP-SLAM's count model, the same as GMapping's). A wall cell that the
+// robot mostly sees at a grazing angle is crossed by many beams in front of the wall
+// surface and ends a quarter or a third of them, far below map_server's default
+// occupied_thresh of 0.65, at which corridor walls would read as unknown or free. So the
+// YAML says what GMapping's map output says for the same model: occupied above 0.25
+// (its occ_thresh); free_thresh stays 0.196.
+inline constexpr double kSlamOccupiedThreshold = 0.25;
+io::MapWriteOptions slam_map_thresholds();
+
 // Writes the trajectories (write_trajectories) and, when the image is not empty,
-// out_dir/map.pgm, map.yaml and map.png. False (with `error`) at the first write that failed; the files already
-// written and the previous versions of the others stay complete.
+// out_dir/map.pgm, map.yaml (slam_map_thresholds()) and map.png. False (with `error`) at
+// the first write that failed; the files already written and the previous versions of the
+// others stay complete.
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
                               const io::OccupancyImage& image, std::string* error);
 
