@@ -88,7 +88,7 @@ std::function<int()> setup_localize(CLI::App& app) {
       ->check(whole_number(UINT64_MAX));
   app.add_option("--min-particles", args->min_particles, "KLD-sampling's floor (default 200)")
       ->check(whole_number(1000000U));
-  app.add_option("--max-particles", args->max_particles, "KLD-sampling's ceiling and memory (default 5000)")
+  app.add_option("--max-particles", args->max_particles, "KLD-sampling's ceiling and memory (default 20000)")
       ->check(whole_number(1000000U));
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)")->check(whole_number(UINT64_MAX));
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");

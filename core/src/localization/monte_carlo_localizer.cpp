@@ -279,45 +279,108 @@ void MonteCarloLocalizer::weigh(const RangeScan& scan) {
   const double scale = used > options_.independent_beams
                            ? static_cast<double>(options_.independent_beams) / static_cast<double>(used)
                            : 1.0;
-  // Augmented MCL's measure of fit: the mean over particles of the per-beam geometric mean
-  // likelihood (a scan's product of `used` beams would under- or overflow).
-  if (used > 0U) {
-    double mean = 0.0;
-    for (std::uint32_t i = 0; i < count_; ++i) mean += det::exp(log_w_[i] / static_cast<double>(used));
-    mean /= static_cast<double>(count_);
-    if (w_slow_ == 0.0) w_slow_ = w_fast_ = mean;
-    w_slow_ += options_.recovery_alpha_slow * (mean - w_slow_);
-    w_fast_ += options_.recovery_alpha_fast * (mean - w_fast_);
-  }
   for (std::uint32_t i = 0; i < count_; ++i) log_w_[i] *= scale;
+  // Augmented MCL's measure of how well the belief explains the scan: the per-beam
+  // (geometric mean) likelihood of each particle, averaged with the particles' weights.
+  // Thrun's plain average over the set would count the random particles of a recovery
+  // as the belief and drop further because of them, asking for more.
+  if (used > 0U) {
+    double max = -kInfinity;
+    for (std::uint32_t i = 0; i < count_; ++i) max = log_w_[i] > max ? log_w_[i] : max;
+    double sw = 0.0, fit = 0.0;
+    for (std::uint32_t i = 0; i < count_; ++i) {
+      const double w = det::exp(log_w_[i] - max);
+      sw += w;
+      fit += w * det::exp(log_w_[i] / (scale * static_cast<double>(used)));
+    }
+    fit /= sw;
+    if (w_slow_ == 0.0) w_slow_ = w_fast_ = fit;
+    w_slow_ += options_.recovery_alpha_slow * (fit - w_slow_);
+    w_fast_ += options_.recovery_alpha_fast * (fit - w_fast_);
+  }
 }
 
-// The estimate: mean pose and spread of the weighed set (log_w_, before resampling: the
-// random particles of a recovery weigh little there, while in the resampled set they
-// would count as much as the rest), or of the set as drawn before any scan.
+// The estimate: the weighed set's heaviest mode — of the neighbourhoods (kModeRadiusM,
+// kModeTurnRad) of the kModeCandidates heaviest particles, the one holding the most
+// weight, and the weighted mean of its particles (a distant cluster, such as random
+// particles of a recovery that found a similar place, neither drags the pose between the
+// two nor wins by one lucky particle) — and the spread of the whole weighed set about it
+// (a multimodal set shows as a large spread). Before any scan, all particles count alike.
 void MonteCarloLocalizer::summarise() {
   if (count_ == 0U) return;
+  constexpr double kModeRadiusM = 1.0;
+  constexpr double kModeTurnRad = 0.5;
+  constexpr std::uint32_t kModeCandidates = 8U;
   double max = -kInfinity;
   for (std::uint32_t i = 0; i < count_; ++i) max = log_w_[i] > max ? log_w_[i] : max;
+  const auto near = [&](const Pose2& p, const Pose2& q) {
+    const double dx = p.x_m - q.x_m, dy = p.y_m - q.y_m;
+    const double dt = normalize_angle_rad(p.heading_rad - q.heading_rad);
+    return dx * dx + dy * dy <= kModeRadiusM * kModeRadiusM && dt <= kModeTurnRad && dt >= -kModeTurnRad;
+  };
+  // The candidates: the heaviest particles, each outside the others' neighbourhoods.
+  std::uint32_t candidate[kModeCandidates];
+  std::uint32_t candidates = 0U;
+  double floor = kInfinity;  // weight of the lightest candidate while the list is full
+  for (std::uint32_t i = 0; i < count_; ++i) {
+    if (candidates == kModeCandidates && !(log_w_[i] > floor)) continue;
+    bool merged = false;
+    for (std::uint32_t c = 0; c < candidates && !merged; ++c) {
+      if (near(pose_[i], pose_[candidate[c]])) {
+        if (log_w_[i] > log_w_[candidate[c]]) candidate[c] = i;
+        merged = true;
+      }
+    }
+    if (!merged) {
+      if (candidates < kModeCandidates) {
+        candidate[candidates++] = i;
+      } else {
+        std::uint32_t lightest = 0U;
+        for (std::uint32_t c = 1; c < candidates; ++c) lightest = log_w_[candidate[c]] < log_w_[candidate[lightest]] ? c : lightest;
+        candidate[lightest] = i;
+      }
+    }
+    if (candidates == kModeCandidates) {
+      floor = kInfinity;
+      for (std::uint32_t c = 0; c < candidates; ++c) floor = log_w_[candidate[c]] < floor ? log_w_[candidate[c]] : floor;
+    }
+  }
+  std::uint32_t best = candidate[0];
+  double best_mass = -1.0;
+  for (std::uint32_t c = 0; c < candidates; ++c) {
+    double mass = 0.0;
+    for (std::uint32_t i = 0; i < count_; ++i) {
+      if (near(pose_[i], pose_[candidate[c]])) mass += det::exp(log_w_[i] - max);
+    }
+    if (mass > best_mass) {
+      best_mass = mass;
+      best = candidate[c];
+    }
+  }
   const bool weighed = have_update_ && max > -kInfinity;
+  auto weight = [&](std::uint32_t i) { return weighed ? det::exp(log_w_[i] - max) : 1.0; };
+  const Pose2 peak = pose_[best];
   double sw = 0.0, sx = 0.0, sy = 0.0, sc = 0.0, ss = 0.0;
   for (std::uint32_t i = 0; i < count_; ++i) {
-    const double w = weighed ? det::exp(log_w_[i] - max) : 1.0;
+    const Pose2& p = pose_[i];
+    if (weighed && !near(p, peak)) continue;
+    const double w = weight(i);
     sw += w;
-    sx += w * pose_[i].x_m;
-    sy += w * pose_[i].y_m;
-    sc += w * det::cos(pose_[i].heading_rad);
-    ss += w * det::sin(pose_[i].heading_rad);
+    sx += w * p.x_m;
+    sy += w * p.y_m;
+    sc += w * det::cos(p.heading_rad);
+    ss += w * det::sin(p.heading_rad);
   }
   const double mx = sx / sw, my = sy / sw;
-  double var = 0.0;
+  double var = 0.0, total = 0.0;
   for (std::uint32_t i = 0; i < count_; ++i) {
-    const double w = weighed ? det::exp(log_w_[i] - max) : 1.0;
+    const double w = weight(i);
     const double dx = pose_[i].x_m - mx, dy = pose_[i].y_m - my;
+    total += w;
     var += w * (dx * dx + dy * dy);
   }
   estimate_ = Pose2{mx, my, det::atan2(ss, sc)};
-  spread_m_ = det::sqrt(var / sw);
+  spread_m_ = det::sqrt(var / total);
 }
 
 // KLD-sampling (Fox 2003, Table 8.4) from the weighed set, with augmented MCL's random
@@ -338,8 +401,12 @@ void MonteCarloLocalizer::resample() {
     for (std::uint32_t i = 0; i < count_; ++i) cumulative_[i] = static_cast<double>(i + 1U);
     total = static_cast<double>(count_);
   }
+  // Random particles only once the belief explains the scans at most half as well as it
+  // has over the long run (a per-beam likelihood halved: about 0.7 nats per beam, far
+  // beyond the fit's swing from a clean corridor to a cluttered room), in proportion to
+  // how far below that it fell: 1 − 2 w_fast / w_slow.
   const double inject =
-      (options_.recovery_alpha_fast > 0.0 && w_slow_ > 0.0) ? 1.0 - w_fast_ / w_slow_ : 0.0;
+      (options_.recovery_alpha_fast > 0.0 && w_slow_ > 0.0) ? 1.0 - 2.0 * w_fast_ / w_slow_ : 0.0;
   for (std::uint32_t b = 0; b < bin_capacity_; ++b) bins_[b] = 0U;
   // The bin table has room for 2 × max_particles keys and each draw adds at most one.
   std::uint32_t bins = 0U;

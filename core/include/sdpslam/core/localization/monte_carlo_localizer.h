@@ -9,9 +9,13 @@
 //     as make the Kullback-Leibler distance between the sample and the belief below
 //     kld_error with probability kld_quantile, between min_particles and max_particles
 //     (few when the pose is known, many while it is not);
-//   - augmented MCL (Table 8.3): a short- and a long-term average of the measurement
-//     likelihood; when the short one falls below the long one (the robot is lost, or was
-//     moved), that share of the new particles is drawn at random free cells, as AMCL does.
+//   - augmented MCL (Table 8.3): a short- and a long-term average of how well the belief
+//     explains the scans; when the short one falls below half the long one (the robot is
+//     lost, or was carried), a share of the new particles, 1 − 2·short/long, is drawn at
+//     random free cells. (Thrun's rule, 1 − short/long, also fires on the ordinary swing
+//     of the fit from place to place, and the random particles it keeps adding make a
+//     tracked robot jump to look-alike places.)
+// The estimate is the heaviest mode of the weighed particles, not their mean.
 // The odometry motion model is the bottom level's (motion_model.h, Table 5.6).
 //
 // Memory: everything is carved from the arena at init (required_arena_bytes): one float
@@ -30,7 +34,7 @@ namespace sdpslam {
 
 struct LocalizerOptions {
   std::uint32_t min_particles = 200U;    // KLD floor, >= 10
-  std::uint32_t max_particles = 5000U;   // KLD ceiling and memory, min_particles .. 1,000,000
+  std::uint32_t max_particles = 20000U;  // KLD ceiling and memory, min_particles .. 1,000,000
   double kld_error = 0.05;               // ε, (0, 1)
   double kld_quantile_z = 2.326;         // z_(1-δ): 2.326 for δ = 0.01, (0, 10]
   double kld_bin_xy_m = 0.5;             // histogram bins of the KLD bound, (0, 10]
