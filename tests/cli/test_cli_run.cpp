@@ -24,6 +24,14 @@ using Run = sdpslam::test::ProgramRun;
 
 Run run_cli(const std::string& args) { return sdpslam::test::run_program(std::string(SDPSLAM_CLI_PATH) + " " + args); }
 
+// The whole file (empty when it cannot be read).
+std::string text_of(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 std::size_t lines_in(const std::string& path) {
   std::ifstream in(path);
   std::size_t n = 0;
@@ -121,11 +129,9 @@ TEST(CliRun, an_odometry_jump_and_time_going_backwards_are_reported_and_handled)
       }
     }
     CHECK_TEXT(max_x < 2.0, mode);
-    std::ifstream js(dir + "/out/stats.json");
-    std::stringstream ss;
-    ss << js.rdbuf();
-    STRCMP_CONTAINS("\"odometry_jumps_removed\": 1", ss.str().c_str());
-    STRCMP_CONTAINS("\"scans_stamped_backwards\": 1", ss.str().c_str());
+    const std::string stats = text_of(dir + "/out/stats.json");
+    STRCMP_CONTAINS("\"odometry_jumps_removed\": 1", stats.c_str());
+    STRCMP_CONTAINS("\"scans_stamped_backwards\": 1", stats.c_str());
   }
 }
 
@@ -154,11 +160,9 @@ TEST(CliRun, outputs_are_one_run_s_set) {
   const std::string out = dir + "/out";
   Run r = run_cli("run " + log + " --mode sdp --out " + out);
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
-  std::ifstream sdp_manifest(out + "/manifest.txt");
-  std::stringstream m1;
-  m1 << sdp_manifest.rdbuf();
-  STRCMP_CONTAINS(" icp_error.csv\n", m1.str().c_str());
-  STRCMP_CONTAINS(" trajectory.txt\n", m1.str().c_str());
+  const std::string m1 = text_of(out + "/manifest.txt");
+  STRCMP_CONTAINS(" icp_error.csv\n", m1.c_str());
+  STRCMP_CONTAINS(" trajectory.txt\n", m1.c_str());
   // What a run killed between write and rename leaves (pid 2^22 + 1 is above Linux's
   // largest pid, so no process owns it).
   {
@@ -171,11 +175,9 @@ TEST(CliRun, outputs_are_one_run_s_set) {
   CHECK_FALSE(probe.good());
   std::ifstream torn(out + "/.map.pgm.tmp.4194305.0");
   CHECK_FALSE(torn.good());
-  std::ifstream dp_manifest(out + "/manifest.txt");
-  std::stringstream m2;
-  m2 << dp_manifest.rdbuf();
-  CHECK_TEXT(m2.str().find("icp_error") == std::string::npos, m2.str().c_str());
-  STRCMP_CONTAINS(" stats.json\n", m2.str().c_str());
+  const std::string m2 = text_of(out + "/manifest.txt");
+  CHECK_TEXT(m2.find("icp_error") == std::string::npos, m2.c_str());
+  STRCMP_CONTAINS(" stats.json\n", m2.c_str());
 }
 
 // On a terminal the progress line is drawn (\r-redrawn, the end once); --quiet draws
@@ -222,10 +224,7 @@ TEST(CliRun, the_trajectory_is_also_written_in_tum_format) {
       DOUBLES_EQUAL(txt[i].pose.y_m, tum[i].pose.y_m, 1e-6);
       DOUBLES_EQUAL(txt[i].pose.heading_rad, tum[i].pose.heading_rad, 1e-6);
     }
-    std::ifstream manifest(out + "/manifest.txt");
-    std::stringstream m;
-    m << manifest.rdbuf();
-    STRCMP_CONTAINS(" trajectory.tum\n", m.str().c_str());
+    STRCMP_CONTAINS(" trajectory.tum\n", text_of(out + "/manifest.txt").c_str());
   }
 }
 
@@ -420,19 +419,14 @@ TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   r = run_cli("run " + dir + "/sim/sim.clf --seed 4 --quiet --out " + dir + "/run");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
-  std::ifstream manifest(dir + "/run/manifest.txt");
-  std::stringstream m;
-  m << manifest.rdbuf();
-  STRCMP_CONTAINS(" loops.tsv\n", m.str().c_str());
+  STRCMP_CONTAINS(" loops.tsv\n", text_of(dir + "/run/manifest.txt").c_str());
   CHECK_TRUE(lines_in(dir + "/run/loops.tsv") >= 2U);
   r = run_cli("evaluate --loops " + dir + "/run/loops.tsv --ground-truth " + dir + "/sim/ground_truth.txt --json " +
               dir + "/loops.json");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   STRCMP_CONTAINS(" 0 without a ground-truth origin", r.out.c_str());
-  std::ifstream json_file(dir + "/loops.json");
-  std::stringstream json;
-  json << json_file.rdbuf();
-  const std::string used = json.str().substr(json.str().find("\"used\""));
+  const std::string json = text_of(dir + "/loops.json");
+  const std::string used = json.substr(json.find("\"used\""));
   STRCMP_CONTAINS("\"between\": 0, \"wrong\": 0", used.c_str());
   CHECK_TEXT(used.find("\"count\": 0,") == std::string::npos, used.c_str());
 }
@@ -455,11 +449,9 @@ TEST(CliRun, localize_on_the_world_map_follows_the_true_path) {
               dir + "/loc");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   STRCMP_CONTAINS("converged at scan 0", r.out.c_str());
-  std::ifstream manifest(dir + "/loc/manifest.txt");
-  std::stringstream m;
-  m << manifest.rdbuf();
+  const std::string manifest = text_of(dir + "/loc/manifest.txt");
   for (const char* name : {" trajectory.txt\n", " trajectory.tum\n", " map.png\n", " particles.tsv\n", " stats.json\n"}) {
-    STRCMP_CONTAINS(name, m.str().c_str());
+    STRCMP_CONTAINS(name, manifest.c_str());
   }
   LONGS_EQUAL(lines_in(dir + "/sim/ground_truth.txt"), lines_in(dir + "/loc/trajectory.txt"));
   r = run_cli("evaluate --ground-truth " + dir + "/sim/ground_truth.txt --trajectory " + dir + "/loc/trajectory.txt");
