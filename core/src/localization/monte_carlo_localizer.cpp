@@ -113,8 +113,7 @@ std::size_t MonteCarloLocalizer::required_arena_bytes(const LocalizerOptions& o,
   const std::size_t cells = static_cast<std::size_t>(m.width) * m.height;
   const std::size_t line = m.width > m.height ? m.width : m.height;
   const std::size_t p = o.max_particles;
-  return Arena::bytes_for<float>(cells) + Arena::bytes_for<std::uint32_t>(count_cells(m, LocalizerMap::kFree)) +
-         2U * Arena::bytes_for<Pose2>(p) + 2U * Arena::bytes_for<double>(p) +
+  return Arena::bytes_for<std::uint8_t>(cells) + 2U * Arena::bytes_for<Pose2>(p) + 2U * Arena::bytes_for<double>(p) +
          Arena::bytes_for<std::uint64_t>(bin_capacity_for(o.max_particles)) + 3U * Arena::bytes_for<double>(line + 1U) +
          Arena::bytes_for<std::uint32_t>(line);
 }
@@ -145,8 +144,7 @@ bool MonteCarloLocalizer::init(const LocalizerOptions& o, const LocalizerMap& m,
   const std::size_t cells = static_cast<std::size_t>(width_) * height_;
   const std::uint32_t line = width_ > height_ ? width_ : height_;
   bin_capacity_ = bin_capacity_for(o.max_particles);
-  field_ = arena.allocate_array<float>(cells);
-  free_ = arena.allocate_array<std::uint32_t>(stats_.free_cells);
+  field_ = arena.allocate_array<std::uint8_t>(cells);
   pose_ = arena.allocate_array<Pose2>(o.max_particles);
   next_ = arena.allocate_array<Pose2>(o.max_particles);
   log_w_ = arena.allocate_array<double>(o.max_particles);
@@ -156,16 +154,18 @@ bool MonteCarloLocalizer::init(const LocalizerOptions& o, const LocalizerMap& m,
   double* d = arena.allocate_array<double>(line + 1U);
   double* z = arena.allocate_array<double>(line + 1U);
   std::uint32_t* v = arena.allocate_array<std::uint32_t>(line);
-  if (field_ == nullptr || free_ == nullptr || pose_ == nullptr || next_ == nullptr || log_w_ == nullptr ||
+  if (field_ == nullptr || pose_ == nullptr || next_ == nullptr || log_w_ == nullptr ||
       cumulative_ == nullptr || bins_ == nullptr || f == nullptr || d == nullptr || z == nullptr || v == nullptr) {
     say(why, n, "arena: too small for this map and max_particles (required_arena_bytes)");
     return false;
   }
-  // Squared distance in cells to the nearest occupied cell, columns then rows, kept in
-  // field_ itself. Only distances up to the field's reach matter, so every result is
-  // clamped at reach² (a small integer, exact in a float): a clamped column term is still
-  // at least reach², so the rows' minimum is exact wherever it is below reach².
-  const double reach = static_cast<double>(floor_int(o.max_distance_m / res_m_) + 2);
+  // Distance to the nearest occupied cell, columns then rows (distance_1d), in field_
+  // itself: after the columns a cell holds its distance in cells along its column (an
+  // integer), clamped at the field's reach (at most kReachCells: beyond 5 σ the model is
+  // flat anyway); a clamped term is still at least the reach, so the rows' minimum is
+  // exact wherever it is below it.
+  const std::int64_t want = floor_int(o.max_distance_m / res_m_) + 2;
+  const double reach = static_cast<double>(want < kReachCells ? want : kReachCells);
   const double reach_sq = reach * reach;
   constexpr double kFar = 1.0e20;  // "no occupied cell": finite, so the parabolas stay defined
   for (std::uint32_t c = 0; c < width_; ++c) {
@@ -174,18 +174,14 @@ bool MonteCarloLocalizer::init(const LocalizerOptions& o, const LocalizerMap& m,
     }
     distance_1d(f, height_, d, v, z);
     for (std::uint32_t r = 0; r < height_; ++r) {
-      field_[static_cast<std::size_t>(r) * width_ + c] = static_cast<float>(d[r] < reach_sq ? d[r] : reach_sq);
+      const double g = d[r] < reach_sq ? det::sqrt(d[r]) : reach;  // d is a square of an integer here
+      field_[static_cast<std::size_t>(r) * width_ + c] = static_cast<std::uint8_t>(g);
     }
-  }
-  for (std::uint32_t r = 0; r < height_; ++r) {
-    float* row = field_ + static_cast<std::size_t>(r) * width_;
-    for (std::uint32_t c = 0; c < width_; ++c) f[c] = static_cast<double>(row[c]);
-    distance_1d(f, width_, d, v, z);
-    for (std::uint32_t c = 0; c < width_; ++c) row[c] = static_cast<float>(d[c] < reach_sq ? d[c] : reach_sq);
   }
   // log p(beam ends here) = log(z_hit · N(d; 0, σ) + (1 − z_hit) / (2 · reach)) with d
   // clamped at max_distance_m (Table 6.3; the uniform part spread over the field's reach,
-  // so that both terms are densities in 1/m).
+  // so that both terms are densities in 1/m), kept as one of kLevels steps between its
+  // floor (at max_distance_m) and its peak (on a wall), plus the free-cell bit.
   const double sigma = o.sigma_hit_m;
   const double norm = 1.0 / (det::sqrt(2.0 * kPi) * sigma);
   const double rand_density = (1.0 - o.z_hit) / (2.0 * o.max_distance_m);
@@ -193,12 +189,20 @@ bool MonteCarloLocalizer::init(const LocalizerOptions& o, const LocalizerMap& m,
     if (dist_m > o.max_distance_m) dist_m = o.max_distance_m;
     return det::log(o.z_hit * norm * det::exp(-0.5 * dist_m * dist_m / (sigma * sigma)) + rand_density);
   };
-  std::uint32_t k = 0U;
-  for (std::size_t i = 0; i < cells; ++i) {
-    field_[i] = static_cast<float>(log_p(det::sqrt(static_cast<double>(field_[i])) * res_m_));
-    if (m.cells[i] == LocalizerMap::kFree) free_[k++] = static_cast<std::uint32_t>(i);
+  log_floor_ = log_p(o.max_distance_m);
+  log_step_ = (log_p(0.0) - log_floor_) / static_cast<double>(kLevels - 1U);
+  for (std::uint32_t r = 0; r < height_; ++r) {
+    std::uint8_t* row = field_ + static_cast<std::size_t>(r) * width_;
+    for (std::uint32_t c = 0; c < width_; ++c) f[c] = static_cast<double>(row[c]) * static_cast<double>(row[c]);
+    distance_1d(f, width_, d, v, z);
+    for (std::uint32_t c = 0; c < width_; ++c) {
+      const double dist_m = det::sqrt(d[c] < reach_sq ? d[c] : reach_sq) * res_m_;
+      const auto level = static_cast<double>(floor_int((log_p(dist_m) - log_floor_) / log_step_ + 0.5));
+      const auto q = static_cast<std::uint8_t>(level < 0.0 ? 0.0 : (level > kLevels - 1.0 ? kLevels - 1.0 : level));
+      const bool free = m.cells[static_cast<std::size_t>(r) * width_ + c] == LocalizerMap::kFree;
+      row[c] = static_cast<std::uint8_t>(q | (free ? kFreeBit : 0U));
+    }
   }
-  log_outside_ = static_cast<float>(log_p(o.max_distance_m));
   count_ = 0U;
   have_update_ = false;
   w_slow_ = w_fast_ = 0.0;
@@ -211,16 +215,26 @@ double MonteCarloLocalizer::log_field(double x_m, double y_m) const {
   const double cx = (x_m - origin_x_m_) / res_m_;
   const double cy = (y_m - origin_y_m_) / res_m_;
   if (!(cx >= 0.0 && cy >= 0.0 && cx < static_cast<double>(width_) && cy < static_cast<double>(height_))) {
-    return static_cast<double>(log_outside_);
+    return log_floor_;
   }
-  return static_cast<double>(
-      field_[static_cast<std::size_t>(static_cast<std::uint32_t>(cy)) * width_ + static_cast<std::uint32_t>(cx)]);
+  const std::uint8_t v =
+      field_[static_cast<std::size_t>(static_cast<std::uint32_t>(cy)) * width_ + static_cast<std::uint32_t>(cx)];
+  return log_floor_ + static_cast<double>(v & static_cast<std::uint8_t>(~kFreeBit)) * log_step_;
 }
 
+// A uniform free cell: rejection sampling over the map (free cells are a good share of
+// any building's map), then, after kTries misses, the first free cell from the last one
+// drawn (init made sure there is one).
 Pose2 MonteCarloLocalizer::random_free_pose() {
-  const std::uint32_t i = free_[rng_.below(stats_.free_cells)];
-  const double cx = static_cast<double>(i % width_) + rng_.uniform();
-  const double cy = static_cast<double>(i / width_) + rng_.uniform();
+  constexpr std::uint32_t kTries = 64U;
+  const std::size_t cells = static_cast<std::size_t>(width_) * height_;
+  auto cell = static_cast<std::size_t>(rng_.below(static_cast<std::uint32_t>(cells)));
+  for (std::uint32_t t = 1; t < kTries && (field_[cell] & kFreeBit) == 0U; ++t) {
+    cell = static_cast<std::size_t>(rng_.below(static_cast<std::uint32_t>(cells)));
+  }
+  while ((field_[cell] & kFreeBit) == 0U) cell = cell + 1U < cells ? cell + 1U : 0U;
+  const double cx = static_cast<double>(cell % width_) + rng_.uniform();
+  const double cy = static_cast<double>(cell / width_) + rng_.uniform();
   ++stats_.random_particles;
   return Pose2{origin_x_m_ + cx * res_m_, origin_y_m_ + cy * res_m_, normalize_angle_rad((2.0 * rng_.uniform() - 1.0) * kPi)};
 }

@@ -18,9 +18,10 @@
 // The estimate is the heaviest mode of the weighed particles, not their mean.
 // The odometry motion model is the bottom level's (motion_model.h, Table 5.6).
 //
-// Memory: everything is carved from the arena at init (required_arena_bytes): one float
-// per map cell, one index per free cell, the particles and the KLD bins for
-// max_particles. update() never allocates. Deterministic given the seed (det_math).
+// Memory: everything is carved from the arena at init (required_arena_bytes): one byte
+// per map cell (the likelihood in 128 steps and whether the cell is free), the particles
+// and the KLD bins for max_particles. update() never allocates. Deterministic given the
+// seed (det_math).
 #include <cstddef>
 #include <cstdint>
 
@@ -83,7 +84,7 @@ struct LocalizerStats {
 
 class MonteCarloLocalizer {
  public:
-  // Arena bytes init() needs for this map (its free cells are counted); 0 if invalid.
+  // Arena bytes init() needs for this map; 0 if the options or the map are invalid.
   static std::size_t required_arena_bytes(const LocalizerOptions& options, const LocalizerMap& map);
   // Builds the likelihood field; false (with `why`) on bad options or map, a map without
   // free cells, or a short arena. The filter has no particles until start_*().
@@ -125,9 +126,14 @@ class MonteCarloLocalizer {
   Rng rng_{};
   std::uint32_t width_ = 0U, height_ = 0U;
   double res_m_ = 0.05, origin_x_m_ = 0.0, origin_y_m_ = 0.0;
-  float* field_ = nullptr;           // log p per cell
-  float log_outside_ = 0.0F;         // log p of a beam ending off the map
-  std::uint32_t* free_ = nullptr;    // indices of the free cells
+  // Per cell: log p as one of kLevels steps of log_step_ above log_floor_ (a beam ending
+  // off the map, or beyond the field's reach, gets the floor), and kFreeBit for a free cell.
+  static constexpr std::uint32_t kLevels = 128U;
+  static constexpr std::uint8_t kFreeBit = 0x80U;
+  static constexpr std::int64_t kReachCells = 250;  // fits the column pass's byte
+  std::uint8_t* field_ = nullptr;
+  double log_floor_ = 0.0;
+  double log_step_ = 0.0;
   Pose2* pose_ = nullptr;            // particles
   Pose2* next_ = nullptr;
   double* log_w_ = nullptr;
