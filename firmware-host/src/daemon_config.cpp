@@ -4,6 +4,7 @@
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/serial_port.h"
 #include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/run_sdp.h"
 
 #include <ini.h>
@@ -17,13 +18,16 @@
 namespace sdpslam::daemon {
 
 const char* to_string(LaserProtocol p) { return p == LaserProtocol::kScip ? "scip" : "sick"; }
-const char* to_string(SlamMode m) { return m == SlamMode::kDpSlam ? "dpslam" : "sdp"; }
+const char* to_string(SlamMode m) {
+  return m == SlamMode::kDpSlam ? "dpslam" : m == SlamMode::kSdp ? "sdp" : "localize";
+}
 
 namespace {
 
 bool parse_mode(const char* text, SlamMode* mode) {
   if (std::strcmp(text, "sdp") == 0) *mode = SlamMode::kSdp;
   else if (std::strcmp(text, "dpslam") == 0) *mode = SlamMode::kDpSlam;
+  else if (std::strcmp(text, "localize") == 0) *mode = SlamMode::kLocalize;
   else return false;
   return true;
 }
@@ -48,7 +52,7 @@ struct ParseState {
 
 // The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
 bool known_section(const std::string& sec) {
-  static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "sdp", "output", "daemon"};
+  static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "sdp", "localize", "output", "daemon"};
   for (const char* k : kOwn) {
     if (sec == k) return true;
   }
@@ -310,7 +314,7 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
   } else if (sec == "slam") {
     if (key == "mode") {
       if (!parse_mode(v, &c.mode)) {
-        *why = "'" + std::string(v) + "' is not a SLAM mode (dpslam, sdp)";
+        *why = "'" + std::string(v) + "' is not a SLAM mode (sdp, dpslam, localize)";
         return R::kBad;
       }
       return R::kOk;
@@ -337,6 +341,32 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       case slam::SdpKeyResult::kApplied: return R::kOk;
       case slam::SdpKeyResult::kInvalid: return R::kBad;
       case slam::SdpKeyResult::kUnknown: return R::kUnknown;
+    }
+  } else if (sec == "localize") {
+    if (key == "map") {
+      if (*v == '\0') {
+        *why = "empty map path";
+        return R::kBad;
+      }
+      c.localize_map = v;
+      return R::kOk;
+    }
+    if (key == "start") {
+      if (*v == '\0') {  // empty: global localization
+        c.localize_have_start = false;
+        return R::kOk;
+      }
+      if (!slam::parse_start_pose(v, &c.localize_start)) {
+        *why = "'" + std::string(v) + "' is not a pose x, y, theta (m, m, rad) in the map's frame";
+        return R::kBad;
+      }
+      c.localize_have_start = true;
+      return R::kOk;
+    }
+    if (key == "min_particles" || key == "max_particles") {
+      if (!int_in(v, 10, 1000000, &i, why)) return R::kBad;
+      (key == "min_particles" ? c.localize.min_particles : c.localize.max_particles) = static_cast<std::uint32_t>(i);
+      return R::kOk;
     }
   } else if (sec == "output") {
     if (key == "directory") {
@@ -487,6 +517,20 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
   // Every check SDP-SLAM's init makes (SdpSlam::check_options): what is approved here starts.
   if (config->mode == SlamMode::kSdp && !SdpSlam::check_options(config->slam.filter, config->sdp, why, sizeof why)) {
     return refuse(why);
+  }
+  if (config->mode == SlamMode::kLocalize) {
+    if (config->localize_map.empty()) {
+      *error = at + "localize.map: mode localize needs the saved map (its map.yaml)";
+      return false;
+    }
+    if (!config->localize.check(why, sizeof why)) return refuse((std::string("localize.") + why).c_str());
+    // The map is read here, as at start: an unreadable map is refused before any work.
+    slam::LocalizationMap map;
+    std::string map_error;
+    if (!slam::load_localization_map(config->localize_map, &map, &map_error)) {
+      *error = slam::locate_option_error(path, "localize.map: " + map_error);
+      return false;
+    }
   }
   // The whole state is sized here, before any work: what is approved here can start.
   const std::size_t arena_bytes = engine_arena_bytes(*config);

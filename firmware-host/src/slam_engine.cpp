@@ -1,8 +1,11 @@
 #include "sdpslam/daemon/slam_engine.h"
 
+#include <cstdio>
+
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::daemon {
@@ -168,16 +171,105 @@ class SdpEngine final : public SlamEngine {
   mutable std::uint32_t known_cells_ = 0U;
 };
 
+// Localization on a saved map ([slam] mode = localize): the Monte Carlo localizer of
+// `sdpslam localize` (core/localization, tools/slam run_localize.h) one scan at a time.
+// The map is not changed: the outputs are the path on it and the map as loaded.
+class LocalizeEngine final : public SlamEngine {
+ public:
+  bool init(const DaemonConfig& c, std::string* error) {
+    map_ = std::make_unique<slam::LocalizationMap>();
+    if (!slam::load_localization_map(c.localize_map, map_.get(), error)) return false;
+    arena_bytes_ = MonteCarloLocalizer::required_arena_bytes(c.localize, map_->map);
+    if (arena_bytes_ == 0U) {
+      *error = c.localize_map + ": a map the localizer cannot hold (at least 2 x 2 cells, at most 65535 a side)";
+      return false;
+    }
+    buffer_.reset(new unsigned char[arena_bytes_]);
+    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
+    mcl_ = std::make_unique<MonteCarloLocalizer>();
+    char why[160];
+    if (!mcl_->init(c.localize, map_->map, *arena_, c.seed, why, sizeof why)) {
+      *error = c.localize_map + ": " + why;
+      return false;
+    }
+    if (c.localize_have_start) {
+      mcl_->start_at(c.localize_start, kStartSigmaXyM, kStartSigmaThetaRad);
+    } else {
+      mcl_->start_global();
+    }
+    poses_.reserve(c.max_trajectory_scans);
+    return true;
+  }
+
+  const char* name() const override { return "localize"; }
+
+  EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
+    const MonteCarloLocalizer::Step r = mcl_->update(odom, scan);
+    if (converged_at_ < 0 && r.updated && r.spread_m < slam::kConvergedSpreadM) {
+      converged_at_ = static_cast<std::int64_t>(mcl_->stats().scans) - 1;
+    }
+    if (poses_.size() < poses_.capacity()) poses_.push_back(io::StampedPose{odom.stamp_us, r.pose});
+    else ++unrecorded_;
+    return EngineStep{r.updated, r.pose};
+  }
+
+  // The estimate at each scan as it was given (localization does not revise the past).
+  std::vector<io::StampedPose> trajectory() const override { return poses_; }
+
+  std::uint32_t map_image(io::OccupancyImage* image) const override {
+    *image = map_->image;
+    return mcl_->stats().free_cells + mcl_->stats().occupied_cells;
+  }
+
+  std::string status_json() const override {
+    const LocalizerStats& st = mcl_->stats();
+    auto u = [](std::uint64_t v) { return std::to_string(v); };
+    char spread[32];
+    std::snprintf(spread, sizeof spread, "%.4f", mcl_->spread_m());
+    return "\"particles\": " + u(mcl_->particle_count()) + ", \"filter_updates\": " + u(st.filter_updates) +
+           ", \"converged_at_scan\": " + std::to_string(converged_at_) + ", \"spread_m\": " + spread +
+           ", \"random_particles\": " + u(st.random_particles) + ", \"kld_capped\": " + u(st.kld_capped) +
+           ", \"arena_bytes\": " + u(arena_bytes_) + ", \"unrecorded_scans\": " + u(unrecorded_);
+  }
+
+  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+
+ private:
+  // The spread of the first particles around a configured start pose (as `sdpslam
+  // localize --start`).
+  static constexpr double kStartSigmaXyM = 0.25;
+  static constexpr double kStartSigmaThetaRad = 0.15;
+  std::unique_ptr<slam::LocalizationMap> map_;
+  std::size_t arena_bytes_ = 0U;
+  std::unique_ptr<unsigned char[]> buffer_;
+  std::unique_ptr<Arena> arena_;
+  std::unique_ptr<MonteCarloLocalizer> mcl_;
+  std::vector<io::StampedPose> poses_;
+  std::int64_t converged_at_ = -1;
+  std::uint64_t unrecorded_ = 0U;
+};
+
 }  // namespace
 
 std::size_t engine_arena_bytes(const DaemonConfig& config) {
   if (config.mode == SlamMode::kSdp) return SdpSlam::required_arena_bytes(config.slam.filter, config.sdp);
+  if (config.mode == SlamMode::kLocalize) {
+    slam::LocalizationMap map;
+    std::string error;
+    if (!slam::load_localization_map(config.localize_map, &map, &error)) return 0U;
+    return MonteCarloLocalizer::required_arena_bytes(config.localize, map.map);
+  }
   return DpSlamFilter::required_arena_bytes(config.slam.filter);
 }
 
 std::unique_ptr<SlamEngine> make_engine(const DaemonConfig& config, std::string* error) {
   if (config.mode == SlamMode::kSdp) {
     auto e = std::make_unique<SdpEngine>();
+    if (!e->init(config, error)) return nullptr;
+    return e;
+  }
+  if (config.mode == SlamMode::kLocalize) {
+    auto e = std::make_unique<LocalizeEngine>();
     if (!e->init(config, error)) return nullptr;
     return e;
   }

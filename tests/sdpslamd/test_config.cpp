@@ -9,6 +9,7 @@
 
 #include "sdpslam/daemon/daemon_config.h"
 #include "sdpslam/daemon/slam_engine.h"
+#include "sdpslam/io/map_image.h"
 #include "sdpslam/slam/run_sdp.h"
 #include "shared_data.h"
 
@@ -129,6 +130,9 @@ TEST(SdpslamdConfig, the_shipped_file_sets_every_key_to_its_built_in_default) {
       SDPSLAM_FIELD("sdp.map_tile_capacity", sdp.map_tile_capacity),
       SDPSLAM_FIELD("sdp.map_observation_capacity", sdp.map_observation_capacity),
       SDPSLAM_FIELD("sdp.permanent_map_tiles", sdp.permanent_map_tiles),
+      SDPSLAM_FIELD("localize.start", localize_have_start),
+      SDPSLAM_FIELD("localize.min_particles", localize.min_particles),
+      SDPSLAM_FIELD("localize.max_particles", localize.max_particles),
       SDPSLAM_FIELD("output.directory", output_directory),
       SDPSLAM_FIELD("output.period_s", output_period_us),
       SDPSLAM_FIELD("output.max_trajectory_scans", max_trajectory_scans),
@@ -451,7 +455,7 @@ TEST(SdpslamdConfig, sdp_periodic_segmentation_without_a_period_is_rejected_at_t
 }
 
 TEST(SdpslamdConfig, empty_and_misspelt_modes_are_rejected_with_their_line) {
-  expect_rejected("[can]\ninterface = can0\n[slam]\nmode =\n", 4, "slam.mode: '' is not a SLAM mode (dpslam, sdp)");
+  expect_rejected("[can]\ninterface = can0\n[slam]\nmode =\n", 4, "slam.mode: '' is not a SLAM mode (sdp, dpslam, localize)");
   expect_rejected("[slam]\nseed = 3\nmode = SDP\n", 3, "'SDP' is not a SLAM mode");
 }
 
@@ -483,4 +487,39 @@ TEST(SdpslamdConfig, sdp_keys_in_mode_dpslam_are_warned_about) {
   CHECK_TRUE_TEXT(load_daemon_config(write_ini("[slam]\nmode = sdp\n\n[sdp]\ntop_particles = 20\n"), &d, &error),
                   error.c_str());
   CHECK_TRUE(d.warnings.empty());
+}
+
+// [slam] mode = localize: the saved map is required, read and sized before any work, and
+// a start pose that is not x, y, theta is refused at its line.
+TEST(SdpslamdConfig, localize_mode_needs_a_readable_map_and_a_well_formed_start) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdpslamd_localize");
+  // A 4 m x 3 m room at 0.1 m, written in the map_server convention.
+  sdpslam::io::OccupancyImage room;
+  room.width = 40U;
+  room.height = 30U;
+  room.resolution_m = 0.1;
+  room.occupancy.assign(40U * 30U, 0.0F);
+  for (std::uint32_t r = 0; r < 30U; ++r) {
+    for (std::uint32_t c = 0; c < 40U; ++c) {
+      if (r == 0U || c == 0U || r == 29U || c == 39U) room.occupancy[r * 40U + c] = 1.0F;
+    }
+  }
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::write_map_pgm_yaml(dir + "/room", room, sdpslam::io::MapWriteOptions{}, &error),
+                  error.c_str());
+  DaemonConfig c;
+  const std::string good =
+      write_ini("[slam]\nmode = localize\n[localize]\nmap = " + dir + "/room.yaml\nstart = 1.5, 2, -0.5\n");
+  CHECK_TRUE_TEXT(load_daemon_config(good, &c, &error), error.c_str());
+  CHECK(c.mode == sdpslam::daemon::SlamMode::kLocalize);
+  CHECK_TRUE(c.localize_have_start);
+  DOUBLES_EQUAL(-0.5, c.localize_start.heading_rad, 0.0);
+  CHECK(sdpslam::daemon::engine_arena_bytes(c) > 1200U);  // a byte per cell and the particles
+
+  DaemonConfig d;
+  CHECK_FALSE(load_daemon_config(write_ini("[slam]\nmode = localize\n"), &d, &error));
+  STRCMP_CONTAINS("localize.map: mode localize needs the saved map", error.c_str());
+  expect_rejected("[slam]\nmode = localize\n[localize]\nmap = " + dir + "/room.yaml\nstart = 1, 2\n", 5,
+                  "'1, 2' is not a pose x, y, theta");
+  expect_rejected("[slam]\nmode = localize\n[localize]\nmap = " + dir + "/none.yaml\n", 4, "none.yaml");
 }

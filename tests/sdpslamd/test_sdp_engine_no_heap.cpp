@@ -1,15 +1,18 @@
 // sdpslamd's per-scan path: once created, the SDP engine's process() never touches the heap
 // (the core's guarantee plus the engine's own records, reserved at create time), across
-// segments; and the input recorder that hands it each scan allocates nothing (and formats
-// no text) while no recording is open.
+// segments; the localize engine's likewise; and the input recorder that hands each scan
+// to them allocates nothing (and formats no text) while no recording is open.
 #include <CppUTest/TestHarness.h>
 
 #include <cmath>
 #include <string>
 
+#include "../localization/localizer_world.h"
 #include "alloc_counter.h"
 #include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/slam_engine.h"
+#include "sdpslam/io/map_image.h"
+#include "shared_data.h"
 
 using sdpslam::daemon::DaemonConfig;
 
@@ -99,4 +102,49 @@ TEST(SdpEngineNoHeap, the_input_recorder_allocates_nothing_while_not_recording) 
   LONGS_EQUAL(50, recorder.stats().scans);
   LONGS_EQUAL(50, recorder.stats().changed_count);  // range_min, the NaN / inf beams, the mounting
   LONGS_EQUAL(0, recorder.stats().roundtrip_failures);
+}
+
+// [slam] mode = localize: the engine localizes on a saved map, follows the robot, and its
+// process() allocates nothing once the engine is made (the trajectory record reserved).
+TEST(SdpEngineNoHeap, the_localize_engine_follows_the_robot_without_allocating) {
+  const sdpslam::test::LocalizerWorld world;
+  sdpslam::io::OccupancyImage image;
+  image.width = world.kWidth;
+  image.height = world.kHeight;
+  image.resolution_m = world.kRes;
+  for (const std::uint8_t cell : world.cells) {
+    image.occupancy.push_back(cell == sdpslam::LocalizerMap::kOccupied ? 1.0F : 0.0F);
+  }
+  const std::string dir = sdpslam::test::make_temp_dir("localize_engine");
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::write_map_pgm_yaml(dir + "/world", image, sdpslam::io::MapWriteOptions{}, &error),
+                  error.c_str());
+  DaemonConfig c;
+  c.mode = sdpslam::daemon::SlamMode::kLocalize;
+  c.localize_map = dir + "/world.yaml";
+  const std::vector<sdpslam::Pose2> route = sdpslam::test::localizer_route();
+  c.localize_have_start = true;
+  c.localize_start = route[0];
+  c.max_trajectory_scans = static_cast<std::uint32_t>(route.size());
+  auto engine = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(engine != nullptr, error.c_str());
+  STRCMP_EQUAL("localize", engine->name());
+  static sdpslam::RangeScan scan;
+  std::size_t allocations = 0U;
+  double worst_m = 0.0;
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    world.scan(route[k], static_cast<std::int64_t>(k) * 100000, &scan);
+    const sdpslam::OdometrySample odom{scan.stamp_us, route[k]};
+    sdpslam::test::AllocationScope scope;
+    const sdpslam::daemon::EngineStep step = engine->process(odom, scan);
+    allocations += scope.allocations();
+    worst_m = std::fmax(worst_m, std::hypot(step.pose.x_m - route[k].x_m, step.pose.y_m - route[k].y_m));
+  }
+  LONGS_EQUAL(0, allocations);
+  CHECK_TEXT(worst_m < 0.25, std::to_string(worst_m).c_str());
+  LONGS_EQUAL(route.size(), engine->trajectory().size());
+  sdpslam::io::OccupancyImage out;
+  CHECK(engine->map_image(&out) > 0U);
+  LONGS_EQUAL(world.kWidth, out.width);  // the saved map, unchanged
+  STRCMP_CONTAINS("\"converged_at_scan\": 0", engine->status_json().c_str());
 }

@@ -1,9 +1,7 @@
 // `sdpslam localize LOG --map map.yaml --out D`: Monte Carlo localization of a log on a
 // saved map (tools/slam run_localize.h), globally or from --start.
-#include <cmath>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "cli_common.h"
@@ -24,18 +22,6 @@ struct LocalizeArgs {
   bool quiet = false;
 };
 
-// "x,y,theta" (m, m, rad) -> pose; false on anything else.
-bool parse_pose(const std::string& text, Pose2* pose) {
-  std::istringstream in(text);
-  char c1 = 0, c2 = 0;
-  double x = 0.0, y = 0.0, t = 0.0;
-  if (!(in >> x >> c1 >> y >> c2 >> t) || c1 != ',' || c2 != ',') return false;
-  in >> std::ws;
-  if (!in.eof()) return false;
-  *pose = Pose2{x, y, t};
-  return std::isfinite(x) && std::isfinite(y) && std::isfinite(t);
-}
-
 int run_localize_command(const LocalizeArgs& a) {
   slam::LocalizeRunOptions o;
   o.seed = a.seed;
@@ -43,7 +29,7 @@ int run_localize_command(const LocalizeArgs& a) {
   if (a.min_particles != 0U) o.localizer.min_particles = a.min_particles;
   if (a.max_particles != 0U) o.localizer.max_particles = a.max_particles;
   if (!a.start.empty()) {
-    if (!parse_pose(a.start, &o.start)) {
+    if (!slam::parse_start_pose(a.start, &o.start)) {
       std::fprintf(stderr, "sdpslam localize: --start: expected x,y,theta (m, m, rad), not '%s'\n", a.start.c_str());
       return kExitUsage;
     }

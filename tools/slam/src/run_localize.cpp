@@ -2,7 +2,9 @@
 
 #include <sys/resource.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +37,39 @@ std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::Map
 
 }  // namespace
 
+bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error) {
+  io::MapWriteOptions thresholds;
+  if (!io::read_map_pgm_yaml(map_yaml, &out->image, &thresholds, error)) return false;
+  out->cells = map_cells(out->image, thresholds);
+  out->map = LocalizerMap{};
+  out->map.width = out->image.width;
+  out->map.height = out->image.height;
+  out->map.resolution_m = out->image.resolution_m;
+  out->map.origin_x_m = out->image.origin_x_m;
+  out->map.origin_y_m = out->image.origin_y_m;
+  out->map.cells = out->cells.data();
+  return true;
+}
+
+bool parse_start_pose(const std::string& text, Pose2* pose) {
+  double v[3];
+  const char* p = text.c_str();
+  for (int k = 0; k < 3; ++k) {
+    char* end = nullptr;
+    v[k] = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v[k])) return false;
+    p = end;
+    while (*p == ' ' || *p == '\t') ++p;
+    if (k < 2) {
+      if (*p != ',') return false;
+      ++p;
+    }
+  }
+  if (*p != '\0') return false;
+  *pose = Pose2{v[0], v[1], v[2]};
+  return true;
+}
+
 LocalizeStatus run_localize(const std::string& log_path, const std::string& map_yaml, const LocalizeRunOptions& options,
                             const std::string& out_dir, LocalizeSummary* summary, std::string* error) {
   char why[160];
@@ -42,17 +77,10 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
     *error = std::string("invalid options: localize.") + why;
     return LocalizeStatus::kBadInput;
   }
-  io::OccupancyImage image;
-  io::MapWriteOptions thresholds;
-  if (!io::read_map_pgm_yaml(map_yaml, &image, &thresholds, error)) return LocalizeStatus::kBadInput;
-  const std::vector<std::uint8_t> cells = map_cells(image, thresholds);
-  LocalizerMap map;
-  map.width = image.width;
-  map.height = image.height;
-  map.resolution_m = image.resolution_m;
-  map.origin_x_m = image.origin_x_m;
-  map.origin_y_m = image.origin_y_m;
-  map.cells = cells.data();
+  auto loaded = std::make_unique<LocalizationMap>();
+  if (!load_localization_map(map_yaml, loaded.get(), error)) return LocalizeStatus::kBadInput;
+  const io::OccupancyImage& image = loaded->image;
+  const LocalizerMap& map = loaded->map;
 
   io::LogReader reader;
   if (!reader.open(log_path, options.log, error)) return LocalizeStatus::kBadInput;

@@ -6,7 +6,7 @@
 //   [laser]   serial device, protocol (scip | sick), line speed, timeouts, mounting pose
 //   [robot]   differential-drive geometry (drivers::DiffDriveParams)
 //   [sync]    odometry-to-scan alignment: wait bound, largest gap interpolated, queue
-//   [slam]    mode (dpslam | sdp), profile (sdp mode's starting options, applied before
+//   [slam]    mode (sdp | dpslam | localize), profile (sdp mode's starting options, applied before
 //             every other key wherever it stands) and seed; the filter's own sections [filter] [motion]
 //             [observation] [proposal] [map] [capacity] [log] are the offline runner's
 //             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
@@ -14,6 +14,8 @@
 //             [sdp] keys, parsed by the same code (slam::apply_sdp_key); read in either
 //             mode, used in sdp mode only. The bottom level of sdp mode is [filter] etc.,
 //             with [filter] particles as B (the offline runner takes B from --particles)
+//   [localize] mode = localize: the saved map, the start pose (none: global localization)
+//             and the particle counts of core/localization (Monte Carlo localization)
 //   [output]  directory, write period, trajectory capacity, map, input recording
 //   [daemon]  event-log rate limit, loop slice
 // Unknown sections and keys, malformed and out-of-range values are rejected as
@@ -23,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "sdpslam/core/localization/monte_carlo_localizer.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/sdp_profile.h"
@@ -35,7 +38,7 @@
 namespace sdpslam::daemon {
 
 enum class LaserProtocol : std::uint8_t { kScip, kSick };
-enum class SlamMode : std::uint8_t { kDpSlam, kSdp };
+enum class SlamMode : std::uint8_t { kDpSlam, kSdp, kLocalize };
 const char* to_string(LaserProtocol p);
 const char* to_string(SlamMode m);
 
@@ -72,6 +75,11 @@ struct DaemonConfig {
   slam::SlamConfig slam;
   // [sdp]
   SdpOptions sdp;
+  // [localize]
+  std::string localize_map;        // map.yaml (map_server convention); required in mode localize
+  bool localize_have_start = false;
+  Pose2 localize_start;            // map frame
+  LocalizerOptions localize;
   // [output]
   std::string output_directory = "/var/lib/sdpslamd";
   std::int64_t output_period_us = 5000000;

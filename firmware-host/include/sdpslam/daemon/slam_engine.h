@@ -1,7 +1,8 @@
 #pragma once
 // The SLAM algorithm behind sdpslamd, as a small seam so that the modes of [slam] mode
-// plug in alike: `dpslam` (the bottom-level DP-SLAM filter, core/bottom/dpslam_filter.h) and
-// `sdp` (Segmented DP-SLAM, core/sdp_slam.h, with the [sdp] options).
+// plug in alike: `dpslam` (the bottom-level DP-SLAM filter, core/bottom/dpslam_filter.h),
+// `sdp` (Segmented DP-SLAM, core/sdp_slam.h, with the [sdp] options) and `localize`
+// (Monte Carlo localization on a saved map, core/localization, with [localize]).
 //
 // Both write what the offline runner writes from the same state, through the same code
 // (tools/slam slam_outputs.h): dpslam the best particle's path and map, sdp the best
@@ -50,7 +51,8 @@ class SlamEngine {
 };
 
 // Bytes of the one arena the configured engine carves its state from at create time
-// (DpSlamFilter / SdpSlam::required_arena_bytes); 0 iff the options are invalid. The
+// (DpSlamFilter / SdpSlam / MonteCarloLocalizer::required_arena_bytes; localize reads the
+// map to size it); 0 iff the options are invalid or the map cannot be read. The
 // scan record (max_trajectory_scans × ~64 B) comes on top.
 std::size_t engine_arena_bytes(const DaemonConfig& config);
 

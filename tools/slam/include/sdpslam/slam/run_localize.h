@@ -15,8 +15,10 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "sdpslam/core/localization/monte_carlo_localizer.h"
+#include "sdpslam/io/map_image.h"
 #include "sdpslam/io/log_reader.h"
 
 namespace sdpslam::slam {
@@ -47,6 +49,22 @@ struct LocalizeSummary {
 };
 
 enum class LocalizeStatus { kOk, kBadInput, kIoError, kInternal };
+
+// A saved map as the localizer takes it (`sdpslam localize`, sdpslamd [slam] mode =
+// localize): the image read by io::read_map_pgm_yaml and its cells classed by the YAML's
+// thresholds as map_server does. `map.cells` points into `cells`: keep the object alive
+// (and unmoved) while the map is in use.
+struct LocalizationMap {
+  io::OccupancyImage image;
+  std::vector<std::uint8_t> cells;
+  LocalizerMap map;
+};
+// False, with "file[:line]: why", when the map cannot be read.
+bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error);
+
+// "x,y,theta" (m, m, rad; spaces allowed around the commas) to a pose; false on anything
+// else, a non-finite number included.
+bool parse_start_pose(const std::string& text, Pose2* pose);
 
 // The spread below which a run counts as converged (issue benchmark, stats.json).
 inline constexpr double kConvergedSpreadM = 0.2;
