@@ -5,10 +5,12 @@
 #include <CppUTest/TestHarness.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "../localization/localizer_world.h"
 #include "alloc_counter.h"
+#include "sdpslam/daemon/daemon.h"
 #include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/io/map_image.h"
@@ -147,4 +149,106 @@ TEST(SdpEngineNoHeap, the_localize_engine_follows_the_robot_without_allocating) 
   CHECK(engine->map_image(&out) > 0U);
   LONGS_EQUAL(world.kWidth, out.width);  // the saved map, unchanged
   STRCMP_CONTAINS("\"converged_at_scan\": 0", engine->status_json().c_str());
+}
+
+namespace {
+
+// Sensors and an engine that keep nothing on the heap, so that what is counted below is
+// the daemon's own per-scan path: odometry integration, the scan queue, placement by
+// interpolation, the input recorder, the engine call and the latency figures.
+struct QuietClock final : sdpslam::hal::MonotonicClock {
+  std::int64_t now_us() const override { return t; }
+  std::int64_t t = 1000000;
+};
+struct QuietEncoders final : sdpslam::hal::WheelEncoderSource {
+  int update() override { return 0; }
+  sdpslam::hal::WheelEncoderSample latest() const override { return s; }
+  void sample(std::uint32_t ticks, std::int64_t stamp_us) {
+    for (sdpslam::hal::WheelTicks* w : {&s.left, &s.right}) {
+      w->raw_count = ticks;
+      w->stamp_us = stamp_us;
+      ++w->sequence;
+      w->has_sample = true;
+      w->stale = false;
+    }
+  }
+  sdpslam::hal::WheelEncoderSample s;
+};
+struct QuietLaser final : sdpslam::hal::RangeScanSource {
+  int poll(sdpslam::RangeScan& out, std::int64_t) override {
+    if (!ready) return 0;
+    out = scan;
+    ready = false;
+    ++st.scan_count;
+    return 1;
+  }
+  sdpslam::hal::RangeSourceHealth health() const override { return sdpslam::hal::RangeSourceHealth::kStreaming; }
+  const sdpslam::hal::RangeSourceStats& stats() const override { return st; }
+  sdpslam::RangeScan scan;
+  bool ready = false;
+  sdpslam::hal::RangeSourceStats st;
+};
+struct CountingEngine final : sdpslam::daemon::SlamEngine {
+  const char* name() const override { return "counting"; }
+  sdpslam::daemon::EngineStep process(const sdpslam::OdometrySample& odom, const sdpslam::RangeScan&) override {
+    ++processed;
+    return sdpslam::daemon::EngineStep{true, odom.pose};
+  }
+  std::vector<sdpslam::io::StampedPose> trajectory() const override { return {}; }
+  std::uint32_t map_image(sdpslam::io::OccupancyImage*) const override { return 0U; }
+  std::string status_json() const override { return "\"counting\": true"; }
+  std::uint64_t unrecorded_scans() const override { return 0U; }
+  std::uint64_t processed = 0U;
+};
+
+}  // namespace
+
+// The robot's per-scan path, end to end in the loop: with no recording open and between
+// output periods, placing and processing scans allocates nothing.
+TEST(SdpEngineNoHeap, the_daemon_loop_places_and_processes_scans_without_allocating) {
+  QuietClock clock;
+  QuietEncoders encoders;
+  QuietLaser laser;
+  CountingEngine engine;
+  static char log_buffer[4096];
+  std::FILE* log_file = std::tmpfile();
+  std::setvbuf(log_file, log_buffer, _IOFBF, sizeof log_buffer);  // the log's buffer is not the heap's
+  sdpslam::daemon::EventLog log(clock, 0, log_file);
+  DaemonConfig config;
+  config.output_directory = sdpslam::test::make_temp_dir("daemon_no_heap");
+  config.output_period_us = 3600000000LL;  // no output step inside the measurement
+  config.write_map = false;
+  config.loop_slice_us = 100;
+  sdpslam::daemon::DaemonIo io;
+  io.clock = &clock;
+  io.encoders = &encoders;
+  io.laser = &laser;
+  io.engine = &engine;
+  auto daemon = std::make_unique<sdpslam::daemon::Daemon>(config, io, log);
+  std::string error;
+  CHECK_TRUE_TEXT(daemon->start(&error), error.c_str());
+  laser.scan.beam_count = 181U;
+  laser.scan.geometry.angle_min_rad = static_cast<float>(-M_PI / 2.0);
+  laser.scan.geometry.angle_increment_rad = static_cast<float>(M_PI / 180.0);
+  laser.scan.geometry.range_max_m = 30.0F;
+  for (std::uint32_t i = 0; i < 181U; ++i) laser.scan.ranges_m[i] = 2.0F + 0.01F * static_cast<float>(i);
+  std::size_t allocations = 0U;
+  std::uint64_t measured_from = 0U;
+  for (int k = 0; k < 400; ++k) {
+    // Odometry every 50 ms, a scan between every other pair of samples.
+    const std::int64_t t = 1000000 + 50000LL * k;
+    clock.t = t;
+    encoders.sample(static_cast<std::uint32_t>(100 * k), t);
+    if (k % 2 == 1) {
+      laser.scan.stamp_us = t - 25000;
+      laser.ready = true;
+    }
+    if (k == 40) measured_from = engine.processed;  // past the start-up (first log lines, latching)
+    sdpslam::test::AllocationScope scope;
+    daemon->step();
+    if (k >= 40) allocations += scope.allocations();
+  }
+  LONGS_EQUAL(0, allocations);
+  CHECK(engine.processed - measured_from > 150U);  // scans were placed and processed meanwhile
+  std::fclose(log_file);
 }
