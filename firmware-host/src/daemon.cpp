@@ -1,13 +1,17 @@
 #include "sdpslam/daemon/daemon.h"
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/map_image.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::daemon {
@@ -225,10 +229,67 @@ void Daemon::step() {
   }
 }
 
-bool Daemon::run(const volatile std::sig_atomic_t* stop) {
-  while (*stop == 0) step();
+bool Daemon::run(const volatile std::sig_atomic_t* stop, volatile std::sig_atomic_t* localize) {
+  while (*stop == 0) {
+    if (localize != nullptr && *localize != 0) {
+      *localize = 0;
+      std::string error;
+      (void)switch_to_localization(&error);  // logged either way
+    }
+    step();
+  }
   log_.log(Event::kShutdown, "signal received: finishing");
   return finish();
+}
+
+void Daemon::adopt_engine(std::unique_ptr<SlamEngine> engine) {
+  owned_engine_ = std::move(engine);
+  io_.engine = owned_engine_.get();
+}
+
+bool Daemon::switch_to_localization(std::string* error) {
+  auto refuse = [&](const std::string& why) {
+    *error = why;
+    log_.log(Event::kOutput, "cannot switch to localization, mapping goes on: %s", why.c_str());
+    return false;
+  };
+  if (config_.mode == SlamMode::kLocalize) return refuse("already localizing");
+  update_odometry();
+  place_scans(io_.clock->now_us(), true);
+  // The map as a periodic output has it (the engine is not finished: should the switch
+  // fail, mapping goes on as before).
+  const std::vector<io::StampedPose> trajectory = io_.engine->trajectory();
+  io::OccupancyImage image;
+  io_.engine->map_image(&image);
+  if (trajectory.empty() || image.width == 0U) return refuse("nothing mapped yet");
+  written_at_scans_ = ~std::uint64_t{0};
+  if (!write_outputs()) return refuse("the outputs could not be written: " + last_output_error_);
+  // The session's map and path, kept beside the output set (which the localization's
+  // outputs replace).
+  const std::string session = config_.output_directory + "/session";
+  if (::mkdir(session.c_str(), 0755) != 0 && errno != EEXIST) {
+    return refuse(session + ": cannot be created: " + std::strerror(errno));
+  }
+  std::string why;
+  if (!io::write_map_pgm_yaml(session + "/map", image, slam::slam_map_thresholds(), &why) ||
+      !slam::write_trajectories(session, trajectory, &why)) {
+    return refuse(why);
+  }
+  DaemonConfig next = config_;
+  next.mode = SlamMode::kLocalize;
+  next.localize_map = session + "/map.yaml";
+  next.localize_have_start = true;
+  next.localize_start = trajectory.back().pose;
+  std::unique_ptr<SlamEngine> engine = make_engine(next, &why);
+  if (!engine) return refuse(why);
+  const char* from = io_.engine->name();
+  log_.log(Event::kStartup, "mode %s -> localize on %s from (%.3f, %.3f, %.3f) after %" PRIu64 " scans placed", from,
+           next.localize_map.c_str(), next.localize_start.x_m, next.localize_start.y_m,
+           next.localize_start.heading_rad, counters_.scans_placed);
+  adopt_engine(std::move(engine));  // the mapping engine is freed here if the daemon owned it
+  config_ = next;
+  written_at_scans_ = ~std::uint64_t{0};
+  return true;
 }
 
 bool Daemon::finish() {

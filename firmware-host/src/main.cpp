@@ -30,7 +30,9 @@
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
+volatile std::sig_atomic_t g_localize = 0;
 void on_signal(int) { g_stop = 1; }
+void on_localize_signal(int) { g_localize = 1; }
 
 enum ExitCode : int { kExitOk = 0, kExitInternal = 1, kExitUsage = 2, kExitBadInput = 3, kExitIo = 4 };
 
@@ -152,6 +154,10 @@ int run_daemon(int argc, char** argv) {
   sa.sa_flags = 0;  // no SA_RESTART: a blocking wait returns at once
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  // SIGUSR1: from mapping to localization on the map just built (Daemon::switch_to_localization).
+  struct sigaction su = sa;
+  su.sa_handler = on_localize_signal;
+  sigaction(SIGUSR1, &su, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
   drivers::LinuxMonotonicClock clock;
@@ -228,11 +234,12 @@ int run_daemon(int argc, char** argv) {
   io.laser_stream = &port;
   io.engine = engine.get();
   auto d = std::make_unique<daemon::Daemon>(config, io, log);
+  d->adopt_engine(std::move(engine));
   if (!d->start(&error)) {
     std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
     return kExitIo;
   }
-  const bool ok = d->run(&g_stop);
+  const bool ok = d->run(&g_stop, &g_localize);
   const daemon::DaemonCounters& c = d->counters();
   const daemon::LatencyFigures lf = d->latency_from_stamp();
   std::fprintf(stderr,

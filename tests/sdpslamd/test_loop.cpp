@@ -102,12 +102,13 @@ class FakeEngine final : public SlamEngine {
     return t;
   }
   std::uint32_t map_image(io::OccupancyImage* image) const override {
-    *image = io::OccupancyImage{};
-    return 0U;
+    *image = map;
+    return static_cast<std::uint32_t>(map.occupancy.size());
   }
   std::string status_json() const override { return "\"fake\": true"; }
   std::uint64_t unrecorded_scans() const override { return 0U; }
   std::vector<OdometrySample> got;
+  io::OccupancyImage map;  // what the engine "mapped" (empty by default)
 };
 
 // 2000 ticks per revolution, radius 0.077 m: 1000 ticks on both wheels = 0.2419 m ahead.
@@ -162,6 +163,15 @@ struct Rig {
 bool file_exists(const std::string& p) {
   struct stat st{};
   return ::stat(p.c_str(), &st) == 0;
+}
+
+std::size_t lines_of(const std::string& path) {
+  std::size_t n = 0U;
+  if (std::FILE* f = std::fopen(path.c_str(), "r")) {
+    for (int ch = std::fgetc(f); ch != EOF; ch = std::fgetc(f)) n += ch == '\n' ? 1U : 0U;
+    std::fclose(f);
+  }
+  return n;
 }
 
 int temp_files_in(const std::string& dir) {
@@ -361,4 +371,41 @@ TEST(SdpslamdLoop, idle_periods_rewrite_nothing_and_the_set_has_a_manifest) {
   std::string error;
   CHECK_TRUE(io::read_trajectory(r.config.output_directory + "/trajectory.txt", &t, &error));
   LONGS_EQUAL(2, t.size());
+}
+
+// Lifelong use (SIGUSR1): from mapping to localization on the map just built. The session's
+// map and path are kept, the next scans go to a localize engine that starts at the last
+// mapped pose, and a second switch, or one before anything was mapped, is refused.
+TEST(SdpslamdLoop, a_switch_to_localization_keeps_the_session_map_and_localizes_on_it) {
+  Rig r;
+  Daemon& d = r.make();
+  std::string error;
+  CHECK_FALSE(d.switch_to_localization(&error));
+  STRCMP_CONTAINS("nothing mapped yet", error.c_str());
+  // A 6 m x 4 m walled room at 0.1 m, as the mapping engine's map.
+  r.engine.map.width = 60U;
+  r.engine.map.height = 40U;
+  r.engine.map.resolution_m = 0.1;
+  r.engine.map.origin_x_m = -1.0;
+  r.engine.map.origin_y_m = -2.0;
+  for (std::uint32_t row = 0; row < 40U; ++row) {
+    for (std::uint32_t c = 0; c < 60U; ++c) {
+      r.engine.map.occupancy.push_back(row == 0U || c == 0U || row == 39U || c == 59U ? 1.0F : 0.0F);
+    }
+  }
+  for (int k = 0; k < 5; ++k) r.scan_between_odometry(100U * static_cast<std::uint32_t>(2 * k), 2000000 + 200000LL * k);
+  const std::uint64_t mapped = d.counters().scans_processed;
+  CHECK(mapped >= 4U);
+  CHECK_TRUE_TEXT(d.switch_to_localization(&error), error.c_str());
+  const std::string session = r.config.output_directory + "/session";
+  CHECK_TRUE(file_exists(session + "/map.yaml"));
+  CHECK_TRUE(file_exists(session + "/map.pgm"));
+  LONGS_EQUAL(lines_of(r.config.output_directory + "/trajectory.txt"), lines_of(session + "/trajectory.txt"));
+  STRCMP_CONTAINS("\"mode\": \"localize\"", d.status_json().c_str());
+  const std::size_t fed_to_mapping = r.engine.got.size();
+  for (int k = 5; k < 8; ++k) r.scan_between_odometry(100U * static_cast<std::uint32_t>(2 * k), 2000000 + 200000LL * k);
+  CHECK(d.counters().scans_placed > mapped);
+  LONGS_EQUAL(fed_to_mapping, r.engine.got.size());  // the mapping engine gets no more scans
+  CHECK_FALSE(d.switch_to_localization(&error));
+  STRCMP_CONTAINS("already localizing", error.c_str());
 }

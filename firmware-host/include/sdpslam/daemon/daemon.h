@@ -22,13 +22,16 @@
 //      into the output directory, each atomically (a failed write keeps the previous file
 //      and is logged and counted; the next period tries again).
 // run() steps until *stop becomes non-zero (SIGINT/SIGTERM), places what can still be
-// placed, and writes the final outputs.
+// placed, and writes the final outputs. When *localize becomes non-zero (SIGUSR1) it
+// switches from mapping to localization on the map just built
+// (switch_to_localization()).
 //
 // Faults are handled by the drivers (serial re-open + sensor restart, SocketCAN re-open);
 // the loop never exits on a sensor fault. Memory: the object holds the scan queue and the
 // latency windows (~100 KiB): allocate it once at start-up.
 #include <csignal>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "sdpslam/core/ring_buffer.h"
@@ -99,8 +102,20 @@ class Daemon {
   bool start(std::string* error);
   void step();
   // Steps until *stop != 0, then finishes (see header). Returns true iff the final
-  // outputs were written.
-  bool run(const volatile std::sig_atomic_t* stop);
+  // outputs were written. Whenever *localize != 0 (may be null), clears it and calls
+  // switch_to_localization().
+  bool run(const volatile std::sig_atomic_t* stop, volatile std::sig_atomic_t* localize = nullptr);
+  // The daemon owns the engine from now on (DaemonIo::engine then points to it), so that
+  // a switch can free it.
+  void adopt_engine(std::unique_ptr<SlamEngine> engine);
+  // Lifelong use: ends mapping and localizes on what it mapped. The scans that can be
+  // placed are, the outputs are written, the map and trajectory are
+  // kept in <output>/session/ (map.pgm/.yaml, trajectory.txt/.tum: the next outputs are
+  // the localization's), and a localize engine ([localize] options) starts on
+  // session/map.yaml at the last pose of the mapped trajectory; the mapping engine is
+  // freed once it runs. False (logged, with *error; mapping goes on) when the engine
+  // already localizes, nothing is mapped yet, or the map cannot be written or loaded.
+  bool switch_to_localization(std::string* error);
   // Places every queued scan that can be placed now (no waiting), ends the engine's input
   // (SlamEngine::finish: the last outputs are the offline runner's), then writes the
   // outputs. Call once, at the end.
@@ -132,6 +147,7 @@ class Daemon {
 
   DaemonConfig config_;
   DaemonIo io_;
+  std::unique_ptr<SlamEngine> owned_engine_;  // adopt_engine(), switch_to_localization()
   EventLog& log_;
   PairedWheelEncoders paired_;  // odometry steps on complete wheel pairs only (see its header)
   drivers::EncoderOdometrySource odom_;
