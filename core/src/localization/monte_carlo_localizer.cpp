@@ -333,7 +333,7 @@ void MonteCarloLocalizer::summarise() {
     return dx * dx + dy * dy <= kModeRadiusM * kModeRadiusM && dt <= kModeTurnRad && dt >= -kModeTurnRad;
   };
   // The candidates: the heaviest particles, each outside the others' neighbourhoods.
-  std::uint32_t candidate[kModeCandidates];
+  std::uint32_t candidate[kModeCandidates] = {};
   std::uint32_t candidates = 0U;
   double floor = kInfinity;  // weight of the lightest candidate while the list is full
   for (std::uint32_t i = 0; i < count_; ++i) {
