@@ -203,6 +203,25 @@ TEST(MapImage, trajectory_png_is_rgb_with_line_and_marked_ends) {
   LONGS_EQUAL(255, at(20, 5, 1));
 }
 
+TEST(MapImage, points_are_drawn_as_orange_pixels_and_off_map_points_are_left_out) {
+  OccupancyImage m;
+  m.width = 40;
+  m.height = 20;
+  m.resolution_m = 0.1;
+  m.occupancy.assign(800, 0.0F);
+  // (1.05, 0.55) -> cell (10, 5) -> image row 14; the others fall outside.
+  const std::vector<sdpslam::Pose2> points{{1.05, 0.55, 0.0}, {-5.0, 0.5, 0.0}, {1.0, 90.0, 0.0}};
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::write_map_png(dir + "/p.png", m, {}, points, &error), error.c_str());
+  const DecodedPng d = decode(dir + "/p.png");
+  LONGS_EQUAL(3, d.channels);
+  const auto at = [&](int x, int y, int ch) { return static_cast<int>(d.px[static_cast<std::size_t>((y * 40 + x) * 3 + ch)]); };
+  LONGS_EQUAL(255, at(10, 14, 0));
+  LONGS_EQUAL(140, at(10, 14, 1));
+  LONGS_EQUAL(0, at(10, 14, 2));
+  LONGS_EQUAL(255, at(11, 14, 2));  // the next pixel: still white
+}
+
 TEST(MapImage, trajectory_far_outside_the_map_is_clipped_not_drawn_forever) {
   OccupancyImage m = small_map();
   std::vector<StampedPose> traj{{0, {-1e12, -1e12, 0.0}}, {1, {1e12, 1e12, 0.0}}};

@@ -85,6 +85,7 @@ struct Rgb {
 constexpr Rgb kPathColour{220, 20, 20};
 constexpr Rgb kStartColour{0, 170, 0};
 constexpr Rgb kEndColour{20, 40, 230};
+constexpr Rgb kPointColour{255, 140, 0};
 constexpr int kMarkerHalfSize = 2;  // markers are 5 x 5 pixel squares
 
 class RgbCanvas {
@@ -171,6 +172,19 @@ bool clip_segment(double* u0, double* v0, double* u1, double* v1, double umax, d
   *u0 = a_u;
   *v0 = a_v;
   return true;
+}
+
+void draw_points(const OccupancyImage& map, const std::vector<Pose2>& points, RgbCanvas* canvas) {
+  for (const Pose2& p : points) {
+    if (!std::isfinite(p.x_m) || !std::isfinite(p.y_m)) continue;
+    double u = 0.0;
+    double v = 0.0;
+    world_to_image(map, p.x_m, p.y_m, &u, &v);
+    if (u < 0.0 || v < 0.0 || u >= static_cast<double>(canvas->width()) || v >= static_cast<double>(canvas->height())) {
+      continue;
+    }
+    canvas->put(std::lround(std::floor(u)), std::lround(std::floor(v)), kPointColour);
+  }
 }
 
 void draw_trajectory(const OccupancyImage& map, const std::vector<StampedPose>& trajectory, RgbCanvas* canvas) {
@@ -293,12 +307,18 @@ bool write_map_pgm_yaml(const std::string& stem, const OccupancyImage& map, cons
 
 bool write_map_png(const std::string& path, const OccupancyImage& map, const std::vector<StampedPose>& trajectory,
                    std::string* error) {
+  return write_map_png(path, map, trajectory, {}, error);
+}
+
+bool write_map_png(const std::string& path, const OccupancyImage& map, const std::vector<StampedPose>& trajectory,
+                   const std::vector<Pose2>& points, std::string* error) {
   if (!check_map(path, map, error)) return false;
   std::vector<std::uint8_t> grey = grey_pixels(map, false);
   std::vector<std::uint8_t> rgb;
-  const bool colour = !trajectory.empty();
+  const bool colour = !trajectory.empty() || !points.empty();
   if (colour) {
     RgbCanvas canvas(map.width, map.height, grey);
+    draw_points(map, points, &canvas);
     draw_trajectory(map, trajectory, &canvas);
     rgb = canvas.pixels();
   }

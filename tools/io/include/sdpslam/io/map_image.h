@@ -69,5 +69,9 @@ bool decode_map_pgm(const std::string& pgm, const std::string& name, const MapYa
 // (RGB PNG) on top, with the start and end marked.
 bool write_map_png(const std::string& path, const OccupancyImage& map, const std::vector<StampedPose>& trajectory,
                    std::string* error);
+// The same with `points` (e.g. a particle filter's particles) drawn as orange pixels under
+// the start and end marks; an empty trajectory and no points give the grey PNG.
+bool write_map_png(const std::string& path, const OccupancyImage& map, const std::vector<StampedPose>& trajectory,
+                   const std::vector<Pose2>& points, std::string* error);
 
 }  // namespace sdpslam::io

@@ -6,7 +6,7 @@
 // one output set (io::OutputSet):
 //  - trajectory.txt / trajectory.tum: one pose per scan in the map's frame (the filter's
 //    estimate at updates, moved with the odometry in between), as `sdpslam run` writes;
-//  - map.png: the map with that path drawn on it;
+//  - map.png: the map with that path drawn on it, and the final particles (orange);
 //  - particles.tsv: the final particle set ("x y theta", one per line);
 //  - stats.json: scans, filter updates, when the estimate first converged (particle
 //    spread below 0.2 m), particle counts, the arena's size, CPU per scan.
