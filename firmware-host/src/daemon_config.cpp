@@ -158,6 +158,14 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
     field = d;
     return R::kOk;
   };
+  auto path = [&](std::string& field, const char* what) {
+    if (*v == '\0') {
+      *why = std::string("empty ") + what;
+      return R::kBad;
+    }
+    field = v;
+    return R::kOk;
+  };
   if (sec == "can") {
     drivers::CanOpenEncoderOptions& co = c.encoders.canopen;
     drivers::ODriveEncoderOptions& od = c.encoders.odrive;
@@ -343,14 +351,7 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       case slam::SdpKeyResult::kUnknown: return R::kUnknown;
     }
   } else if (sec == "localize") {
-    if (key == "map") {
-      if (*v == '\0') {
-        *why = "empty map path";
-        return R::kBad;
-      }
-      c.localize_map = v;
-      return R::kOk;
-    }
+    if (key == "map") return path(c.localize_map, "map path");
     if (key == "start") {
       if (*v == '\0') {  // empty: global localization
         c.localize_have_start = false;
@@ -369,14 +370,7 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       return R::kOk;
     }
   } else if (sec == "output") {
-    if (key == "directory") {
-      if (*v == '\0') {
-        *why = "empty output directory";
-        return R::kBad;
-      }
-      c.output_directory = v;
-      return R::kOk;
-    }
+    if (key == "directory") return path(c.output_directory, "output directory");
     if (key == "period_s") {
       if (!real_in(v, 0.1, 3600.0, false, &d, why)) return R::kBad;
       c.output_period_us = static_cast<std::int64_t>(std::llround(d * 1e6));
