@@ -470,3 +470,15 @@ TEST(CliRun, localize_names_a_bad_start_and_a_missing_map) {
   LONGS_EQUAL(3, r.status);
   STRCMP_CONTAINS("none.yaml", r.out.c_str());
 }
+
+// stats.json stays JSON whatever the log's name: quotes and backslashes are escaped.
+TEST(CliRun, a_log_path_with_quotes_and_backslashes_gives_valid_json) {
+  std::string text;
+  for (int i = 0; i < 10; ++i) text += scan(0.05 * i, 100.0 + 0.1 * i);
+  const std::string log = put("we\"ird\\name.clf", text);
+  for (const char* mode : {"sdp", "dpslam"}) {
+    Run r = run_cli("run '" + log + "' --mode " + mode + " --quiet --out " + dir + "/out");
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    STRCMP_CONTAINS("/we\\\"ird\\\\name.clf\",\n", text_of(dir + "/out/stats.json").c_str());
+  }
+}

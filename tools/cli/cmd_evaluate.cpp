@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "cli_common.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/eval/ate.h"
 #include "sdpslam/eval/log_scans.h"
 #include "sdpslam/eval/loops.h"
@@ -61,39 +62,9 @@ struct EvaluateArgs {
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
 };
 
-// ---- minimal JSON writer (the output is small and flat) --------------------------------
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string json_number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-
 std::string json_stats(const eval::ErrorStats& s) {
-  return "{\"mean\": " + json_number(s.mean) + ", \"std\": " + json_number(s.std_dev) +
-         ", \"max\": " + json_number(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
+  return "{\"mean\": " + io::json_number(s.mean) + ", \"std\": " + io::json_number(s.std_dev) +
+         ", \"max\": " + io::json_number(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
 }
 
 // ---- inputs ------------------------------------------------------------------------------
@@ -192,8 +163,8 @@ int run_relations(const EvaluateArgs& a, std::string* json) {
   row("rotation [deg]", res.rotation_deg);
   row("rotation^2 [deg^2]", res.rotation_deg2);
 
-  *json += "\"relations\": {\"file\": " + json_string(a.relations_path) + ", \"log\": " + json_string(a.log_path) +
-           ", \"trajectory\": " + (a.odometry ? std::string("\"odometry\"") : json_string(a.trajectory_path)) +
+  *json += "\"relations\": {\"file\": " + io::json_quote(a.relations_path) + ", \"log\": " + io::json_quote(a.log_path) +
+           ", \"trajectory\": " + (a.odometry ? std::string("\"odometry\"") : io::json_quote(a.trajectory_path)) +
            ", \"relation_count\": " + std::to_string(res.relation_count) +
            ", \"used_count\": " + std::to_string(res.used_count) +
            ", \"exact_match_count\": " + std::to_string(res.exact_match_count) +
@@ -235,17 +206,17 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
               r.alignment.heading_rad * kRadToDeg);
   std::printf("  position    rmse %.6f m, mean %.6f m, max %.6f m\n", r.rmse_m, r.mean_m, r.max_m);
   std::printf("  heading     rmse %.6f deg\n", r.heading_rmse_rad * kRadToDeg);
-  *json += "\"ate\": {\"trajectory\": " + json_string(a.trajectory_path) +
-           ", \"ground_truth\": " + json_string(a.ground_truth_path) +
+  *json += "\"ate\": {\"trajectory\": " + io::json_quote(a.trajectory_path) +
+           ", \"ground_truth\": " + io::json_quote(a.ground_truth_path) +
            ", \"estimate_count\": " + std::to_string(r.estimate_count) +
            ", \"ground_truth_count\": " + std::to_string(r.ground_truth_count) +
            ", \"matched_count\": " + std::to_string(r.matched_count) +
            ", \"unmatched_estimate_count\": " + std::to_string(r.unmatched_estimate_count) +
-           ", \"rmse_m\": " + json_number(r.rmse_m) + ", \"mean_m\": " + json_number(r.mean_m) +
-           ", \"max_m\": " + json_number(r.max_m) +
-           ", \"heading_rmse_deg\": " + json_number(r.heading_rmse_rad * kRadToDeg) +
-           ", \"alignment\": {\"x_m\": " + json_number(r.alignment.x_m) + ", \"y_m\": " + json_number(r.alignment.y_m) +
-           ", \"heading_rad\": " + json_number(r.alignment.heading_rad) + "}}";
+           ", \"rmse_m\": " + io::json_number(r.rmse_m) + ", \"mean_m\": " + io::json_number(r.mean_m) +
+           ", \"max_m\": " + io::json_number(r.max_m) +
+           ", \"heading_rmse_deg\": " + io::json_number(r.heading_rmse_rad * kRadToDeg) +
+           ", \"alignment\": {\"x_m\": " + io::json_number(r.alignment.x_m) + ", \"y_m\": " + io::json_number(r.alignment.y_m) +
+           ", \"heading_rad\": " + io::json_number(r.alignment.heading_rad) + "}}";
   if (!(a.rpe_m > 0.0)) return kExitOk;
   eval::RpeResult q;
   if (!eval::compute_rpe(estimate, truth, a.tolerance_us, a.rpe_m, &q)) {
@@ -256,18 +227,18 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
               "along-track scale %+.3f %%\n",
               q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
               100.0 * q.scale_error);
-  *json += ", \"rpe\": {\"distance_m\": " + json_number(q.distance_m) +
-           ", \"stretch_count\": " + std::to_string(q.stretch_count) + ", \"mean_m\": " + json_number(q.mean_m) +
-           ", \"rmse_m\": " + json_number(q.rmse_m) + ", \"max_m\": " + json_number(q.max_m) +
-           ", \"heading_mean_deg\": " + json_number(q.heading_mean_rad * kRadToDeg) +
-           ", \"scale_error\": " + json_number(q.scale_error) + "}";
+  *json += ", \"rpe\": {\"distance_m\": " + io::json_number(q.distance_m) +
+           ", \"stretch_count\": " + std::to_string(q.stretch_count) + ", \"mean_m\": " + io::json_number(q.mean_m) +
+           ", \"rmse_m\": " + io::json_number(q.rmse_m) + ", \"max_m\": " + io::json_number(q.max_m) +
+           ", \"heading_mean_deg\": " + io::json_number(q.heading_mean_rad * kRadToDeg) +
+           ", \"scale_error\": " + io::json_number(q.scale_error) + "}";
   return kExitOk;
 }
 
 std::string json_bins(const eval::LoopBins& b) {
   return "{\"count\": " + std::to_string(b.count) + ", \"right\": " + std::to_string(b.right) +
          ", \"between\": " + std::to_string(b.between) + ", \"wrong\": " + std::to_string(b.wrong) +
-         ", \"max_m\": " + json_number(b.max_m) + "}";
+         ", \"max_m\": " + io::json_number(b.max_m) + "}";
 }
 
 int run_loops(const EvaluateArgs& a, std::string* json) {
@@ -291,7 +262,7 @@ int run_loops(const EvaluateArgs& a, std::string* json) {
   row("search", r.search);
   row("icp", r.icp);
   row("used", r.used);
-  *json += "\"loops\": {\"file\": " + json_string(a.loops_path) + ", \"count\": " + std::to_string(r.count) +
+  *json += "\"loops\": {\"file\": " + io::json_quote(a.loops_path) + ", \"count\": " + std::to_string(r.count) +
            ", \"unmatched\": " + std::to_string(r.unmatched) + ", \"search\": " + json_bins(r.search) +
            ", \"icp\": " + json_bins(r.icp) + ", \"used\": " + json_bins(r.used) + "}";
   return kExitOk;
@@ -318,10 +289,10 @@ int run_map_agreement(const EvaluateArgs& a, std::string* json) {
   std::printf("  map         %s: %u x %u cells of %.3f m\n", a.map_path.c_str(), map.width, map.height, map.resolution_m);
   std::printf("  scans       %zu of %zu cast from %s\n", r.scans_cast, r.scan_count, a.trajectory_path.c_str());
   std::printf("  on walls    %zu of %zu returns = %.4f\n", r.on_wall_count, r.return_count, r.share());
-  *json += "\"map_agreement\": {\"map\": " + json_string(a.map_path) + ", \"trajectory\": " + json_string(a.trajectory_path) +
+  *json += "\"map_agreement\": {\"map\": " + io::json_quote(a.map_path) + ", \"trajectory\": " + io::json_quote(a.trajectory_path) +
            ", \"scan_count\": " + std::to_string(r.scan_count) + ", \"scans_cast\": " + std::to_string(r.scans_cast) +
            ", \"return_count\": " + std::to_string(r.return_count) +
-           ", \"on_wall_count\": " + std::to_string(r.on_wall_count) + ", \"share\": " + json_number(r.share()) + "}";
+           ", \"on_wall_count\": " + std::to_string(r.on_wall_count) + ", \"share\": " + io::json_number(r.share()) + "}";
   if (r.scans_cast == 0U) {
     std::fprintf(stderr, "sdpslam evaluate: no scan of %s has a pose in %s\n", a.log_path.c_str(),
                  a.trajectory_path.c_str());

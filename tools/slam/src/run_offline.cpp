@@ -14,6 +14,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/io/trajectory_io.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
 
@@ -117,7 +118,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   auto u = [](std::uint64_t v) { return std::to_string(v); };
   std::string js = "{\n";
-  js += "  \"log\": \"" + log_path + "\",\n";
+  js += "  \"log\": " + io::json_quote(log_path) + ",\n";
   js += "  \"mode\": \"dpslam\",\n  \"particles\": " + u(fo.particle_count) + ",\n  \"seed\": " + u(options.seed) + ",\n";
   js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(st.processed) + ",\n";
   js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";

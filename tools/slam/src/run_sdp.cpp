@@ -19,6 +19,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/io/trajectory_io.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
 
@@ -400,7 +401,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   auto u = [](std::uint64_t v) { return std::to_string(v); };
   const SdpOptions& so = options.sdp;
   std::string js = "{\n";
-  js += "  \"log\": \"" + log_path + "\",\n";
+  js += "  \"log\": " + io::json_quote(log_path) + ",\n";
   js += "  \"mode\": \"sdp\",\n  \"profile\": \"" + std::string(to_string(options.profile)) + "\",\n";
   js += "  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
         "\",\n";
