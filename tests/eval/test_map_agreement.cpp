@@ -154,6 +154,28 @@ TEST(MapRead, a_pixel_above_maxval_is_refused) {
   LONGS_EQUAL(0, r.width);
 }
 
+// What ROS's map savers write: a quoted image name, negate as a boolean, a mode, inline
+// comments; a raw mode (pixels as values) is refused by name.
+TEST(MapRead, the_yaml_of_ros_map_savers_is_read) {
+  OccupancyImage r;
+  MapWriteOptions t;
+  std::string error;
+  put("ros.pgm", std::string("P5 2 1 255\n\x00\xfe", 13U));
+  const std::string yaml = put("ros.yaml", "image: \"ros.pgm\"\nmode: trinary\nresolution: 0.05  # m\n"
+                                           "origin: [-1.0, 2.0, 0.0]\nnegate: false\noccupied_thresh: 0.65\n"
+                                           "free_thresh: '0.25'\n");
+  CHECK_TRUE_TEXT(sdpslam::io::read_map_pgm_yaml(yaml, &r, &t, &error), error.c_str());
+  LONGS_EQUAL(2, r.width);
+  DOUBLES_EQUAL(0.05, r.resolution_m, 1e-12);
+  DOUBLES_EQUAL(0.25, t.free_thresh, 1e-12);
+  CHECK_FALSE(t.negate);
+  DOUBLES_EQUAL(1.0, r.occupancy[0], 1e-6);  // black: occupied
+  DOUBLES_EQUAL(1.0 / 255.0, r.occupancy[1], 1e-6);  // near white: free
+  const std::string raw = put("raw.yaml", "image: ros.pgm\nmode: raw\nresolution: 0.05\norigin: [0, 0, 0]\n");
+  CHECK_FALSE(sdpslam::io::read_map_pgm_yaml(raw, &r, &t, &error));
+  STRCMP_CONTAINS("raw.yaml:2: mode 'raw' is not supported", error.c_str());
+}
+
 // map_server's rule at the thresholds: pixel 14 of maxval 40 is occupancy exactly 0.65,
 // on occupied_thresh, and pixel 32 exactly 0.2, on free_thresh: both unknown.
 TEST(MapRead, a_cell_exactly_on_a_threshold_is_unknown) {

@@ -400,9 +400,22 @@ bool parse_map_yaml(std::istream& yaml, const std::string& yaml_path, MapYaml* o
     if (trim(line).empty() || trim(line)[0] == '#') continue;
     if (colon == std::string::npos) return map_read_error(error, where, "expected 'key: value'");
     const std::string key = trim(line.substr(0, colon));
-    const std::string value = trim(line.substr(colon + 1U));
+    std::string value = trim(line.substr(colon + 1U));
+    // YAML as map_saver and nav2's map_saver write it: an inline comment after " #", and
+    // strings in double or single quotes.
+    const std::size_t comment = value.find(" #");
+    if (comment != std::string::npos) value = trim(value.substr(0, comment));
+    if (value.size() >= 2U && (value.front() == '"' || value.front() == '\'') && value.back() == value.front()) {
+      value = value.substr(1U, value.size() - 2U);
+    }
     if (key == "image") {
       image = value;
+    } else if (key == "mode") {
+      // trinary and scale both class a cell by the thresholds, as read here; raw would
+      // take the pixel as the occupancy value itself.
+      if (value != "trinary" && value != "scale") {
+        return map_read_error(error, where, "mode '" + value + "' is not supported (trinary, scale)");
+      }
     } else if (key == "resolution") {
       if (!parse_real(value, &resolution) || !(resolution > 0.0)) return map_read_error(error, where, "resolution must be > 0");
       have_resolution = true;
@@ -420,8 +433,10 @@ bool parse_map_yaml(std::istream& yaml, const std::string& yaml_path, MapYaml* o
       if (z != 0.0) return map_read_error(error, where, "a rotated origin (yaw != 0) is not supported");
       have_origin = true;
     } else if (key == "negate") {
-      if (value != "0" && value != "1") return map_read_error(error, where, "negate must be 0 or 1");
-      t.negate = value == "1";
+      if (value != "0" && value != "1" && value != "false" && value != "true") {
+        return map_read_error(error, where, "negate must be 0, 1, false or true");
+      }
+      t.negate = value == "1" || value == "true";
     } else if (key == "occupied_thresh") {
       if (!parse_real(value, &t.occupied_thresh)) return map_read_error(error, where, "occupied_thresh is not a number");
     } else if (key == "free_thresh") {
