@@ -66,6 +66,16 @@ bool stamp_fits(std::int64_t stamp_us) {
   return mag / 1000000U < 1000000000000U;
 }
 
+// The robot (odometry) and laser poses a laser line carries, each derived from the other
+// when the record lacks it.
+void line_poses(const LaserRecord& r, Pose2* robot, Pose2* laser_pose) {
+  const ScanGeometry& g = r.scan.geometry;
+  *robot = r.odom_pose;
+  *laser_pose = r.laser_pose;
+  if (!r.has_odom_pose) *robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
+  if (!r.has_laser_pose) *laser_pose = robot->compose(g.laser_in_base);
+}
+
 // One line being formatted.
 struct LineBuilder {
   std::string line;
@@ -100,11 +110,9 @@ std::string format_carmen_laser_line(const LaserRecord& r) {
   LineBuilder s;
   const RangeScan& scan = r.scan;
   const ScanGeometry& g = scan.geometry;
-  // Robot (odometry) pose and laser pose, each derived from the other when missing.
-  Pose2 robot = r.odom_pose;
-  Pose2 laser_pose = r.laser_pose;
-  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
-  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
+  Pose2 robot;
+  Pose2 laser_pose;
+  line_poses(r, &robot, &laser_pose);
   const std::uint32_t n = scan.beam_count <= capacity::kMaxBeams ? scan.beam_count : capacity::kMaxBeams;
 
   if (fits_flaser(r)) {
@@ -134,10 +142,9 @@ CarmenRoundTrip carmen_laser_round_trip(const LaserRecord& r, RangeScan* scan, P
   const RangeScan& in = r.scan;
   const ScanGeometry& g = in.geometry;
   const std::uint32_t n = in.beam_count <= capacity::kMaxBeams ? in.beam_count : capacity::kMaxBeams;
-  Pose2 robot = r.odom_pose;  // as format_carmen_laser_line derives them
-  Pose2 laser_pose = r.laser_pose;
-  if (!r.has_odom_pose) robot = r.has_laser_pose ? r.laser_pose.compose(g.laser_in_base.inverse()) : Pose2{};
-  if (!r.has_laser_pose) laser_pose = robot.compose(g.laser_in_base);
+  Pose2 robot;
+  Pose2 laser_pose;
+  line_poses(r, &robot, &laser_pose);
   if (n < 2U || !finite_pose(robot) || !finite_pose(laser_pose) || !stamp_fits(r.stamp_us) ||
       !stamp_fits(r.logger_stamp_us)) {
     return CarmenRoundTrip::kRefused;
