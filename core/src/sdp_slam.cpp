@@ -349,8 +349,12 @@ void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) con
 SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan) {
   SdpStepResult result;
   if (!initialised_) return result;
+  const std::uint64_t requested_before = filter_->map().observations_requested();
   result.bottom = filter_->process(odom, scan);
   if (result.bottom.status == StepResult::Status::kProcessed) {
+    ++segment_scans_;
+    const std::uint64_t requests = filter_->map().observations_requested() - requested_before;
+    if (requests > scan_requests_) scan_requests_ = requests;
     const Pose2 best = filter_->best_pose();
     if (!started_) {
       started_ = true;
@@ -370,12 +374,21 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
       const double dy = best.y_m - segment_start_pose_.y_m;
       if (!(dx * dx + dy * dy <= window_radius_m_ * window_radius_m_)) end = SegmentEnd::kWindow;
     }
+    if (end == SegmentEnd::kNone && segment_scans_ >= 2U) {
+      // The pool could not take another scan like this one (each particle writes its
+      // scan as new observations before prune folds them into its lineage): the segment
+      // ends, and make_room() frees older levels.
+      const DpMap& map = filter_->map();
+      const std::uint64_t next = scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
+      if (std::uint64_t{map.observation_capacity() - map.observations_used()} < next) end = SegmentEnd::kPool;
+    }
     if (end != SegmentEnd::kNone) {
       const std::uint64_t before = stats_.segments;
       segment(scan.stamp_us);
       if (stats_.segments != before) {
         result.segmented = end;
         if (end == SegmentEnd::kWindow) ++stats_.window_segmentations;
+        if (end == SegmentEnd::kPool) ++stats_.pool_segmentations;
         segmenter_->start(scan.stamp_us, odom.pose);
       }
     }
@@ -424,6 +437,8 @@ void SdpSlam::segment(std::int64_t stamp_us) {
   const std::uint32_t n = filter_->particle_count();
   // Room in the PGS first (bounded memory): the oldest level becomes permanent.
   if (graph_.live_level_count() >= options_.max_levels) make_oldest_permanent();
+  const std::uint64_t room_needed = observations_needed();
+  make_room(room_needed);
   NodeId nodes[capacity::kMaxPgsNodesPerLevel];
   std::uint32_t bottom_best = 0U;
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -476,6 +491,12 @@ void SdpSlam::segment(std::int64_t stamp_us) {
     sm.skeleton_done = false;
   }
   ++stats_.segments;
+  segment_scans_ = 0U;
+  previous_scan_requests_ = scan_requests_;
+  scan_requests_ = 0U;
+  segment_observations_released_ = observations_released_;
+  segment_observations_used_ = filter_->map().observations_used();
+  segment_observations_refused_ = filter_->map().observation_oom_count();
   if (graph_.live_level_count() > stats_.max_live_levels) stats_.max_live_levels = graph_.live_level_count();
   segment_start_pose_ = restart_pose;
   segment_start_stamp_us_ = stamp_us;
@@ -493,6 +514,46 @@ void SdpSlam::segment(std::int64_t stamp_us) {
   round_sq_ = 0.0;
   round_samples_ = 0U;
   update_best();
+  // The segment just anchored may itself leave no room: it is made permanent too.
+  make_room(room_needed);
+}
+
+// Room in the bottom level's observation pool (bounded memory): the next segment is
+// expected to need as many observations as the one ending now took (its growth of the
+// pool, not counting what releases of older submaps gave back meanwhile, plus what the
+// pool refused it), and one scan's writes at once on top (the most a scan of this
+// segment or the previous one asked for). While that does not fit
+// beside what is held, pending releases are done at once, then the oldest level
+// becomes permanent and is released at once (its observations return to the pool),
+// all of them if need be. Fewer live levels only narrow the top level's choice among
+// older segments; a full pool would refuse the new segment's own map updates, and its
+// particles would then weigh scans against a map with holes. When the pool has room,
+// nothing changes: releases stay spread over scans. Checked before the restart and
+// again once the ended segment is a level (which may then go too).
+std::uint64_t SdpSlam::observations_needed() const {
+  const DpMap& map = filter_->map();
+  const std::uint64_t grown_to = std::uint64_t{map.observations_used()} + (observations_released_ - segment_observations_released_);
+  const std::uint64_t grown = grown_to > segment_observations_used_ ? grown_to - segment_observations_used_ : 0U;
+  const std::uint64_t burst = scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
+  return grown + (map.observation_oom_count() - segment_observations_refused_) + burst;
+}
+
+void SdpSlam::make_room(std::uint64_t need) {
+  const DpMap& map = filter_->map();
+  auto short_of_room = [&] {
+    return std::uint64_t{map.observations_used()} + need > std::uint64_t{map.observation_capacity()};
+  };
+  if (!short_of_room()) return;
+  while (release_count_ > 0U) release_one();
+  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+  while (short_of_room() && graph_.live_level_count() > 0U) {
+    const std::uint64_t before = stats_.levels_made_permanent;
+    make_oldest_permanent();
+    if (stats_.levels_made_permanent == before) return;
+    while (release_count_ > 0U) release_one();
+    while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+    ++stats_.levels_made_permanent_for_room;
+  }
 }
 
 void SdpSlam::make_oldest_permanent() {
@@ -592,6 +653,7 @@ void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservat
 std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
   if (!transfer_.active) return 0U;
   const DpMap& map = filter_->map();
+  const std::uint32_t held = map.observations_used();
   const CellRect& r = transfer_.rect;
   std::uint32_t used = 0U;
   if (r.width == 0U || !permanent_map_.initialised()) {
@@ -644,13 +706,18 @@ std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
     if (filter_->release_anchored(transfer_.node)) ++stats_.submaps_released;
     transfer_ = Transfer{};
   }
+  const std::uint32_t left = map.observations_used();
+  if (left < held) observations_released_ += held - left;
   return used > 0U ? used : 1U;
 }
 
 std::uint32_t SdpSlam::release_one() {
   if (release_count_ == 0U) return 0U;
   const NodeId node = release_queue_[--release_count_];
+  const std::uint32_t held = filter_->map().observations_used();
   if (filter_->release_anchored(node)) ++stats_.submaps_released;
+  const std::uint32_t left = filter_->map().observations_used();
+  if (left < held) observations_released_ += held - left;
   return 1U;
 }
 

@@ -26,7 +26,9 @@ inline SdpOptions small_sdp_options() {
   s.rounds_per_segment = 1U;   // keeps the tests quick: the small room overlaps everywhere
   s.max_pairs_per_sample = 3U;
   s.map_tile_capacity = 0U;         // the DP map is sized by the bottom options here
-  s.map_observation_capacity = 0U;
+  // Room for the observations of every live level (a few loops of the room hold ~230,000
+  // at their peak): the tests see the PGS fill, not the pool.
+  s.map_observation_capacity = 300000U;
   return s;
 }
 

@@ -80,6 +80,14 @@ void run_without_heap(const SdpOptions& options, std::uint64_t seed = 9U) {
 
 TEST(SdpNoHeap, many_segments_and_a_full_pgs_allocate_nothing_after_init) { run_without_heap(test::small_sdp_options()); }
 
+// A DP map pool too small for every live level: segments end for the pool and levels
+// become permanent early, released at once (SdpSlam::make_room).
+TEST(SdpNoHeap, a_short_observation_pool_allocates_nothing_after_init) {
+  SdpOptions s = test::small_sdp_options();
+  s.map_observation_capacity = 110000U;
+  run_without_heap(s);
+}
+
 // Loop closure: obstacle points, loop records, the frame graph's solves. The seed is one
 // whose run records loops (checked: a run that closes none would prove nothing here);
 // seed 9 closes none since new segments start from four scans.

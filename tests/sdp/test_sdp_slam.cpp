@@ -302,14 +302,15 @@ TEST(SdpSlam, loop_closure_adjusts_the_frames_and_the_permanent_path_follows) {
 
 // A small ring of permanent submaps forgets the oldest; their cells stay where they were
 // copied while the held ones move with their frames, and the drawn map still agrees
-// with the path better than the map as copied. Measured at rings of 5, 8 and 10: 0.383,
-// 0.314 and 0.310 drawn against 0.376, 0.256 and 0.237 as copied; moving forgotten
-// cells with the oldest held submap's correction instead gave 0.321, 0.291 and 0.253.
+// with the path better than the map as copied. The DP map's pool is the bottom
+// options' (short of room for every live level), so levels become permanent early and
+// many are forgotten.
 TEST(SdpSlam, forgotten_permanent_levels_stay_where_they_were_copied) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
   s.max_permanent_submaps = 8U;
+  s.map_observation_capacity = 0U;  // the bottom options' size
   test::SdpRig a;
   CHECK_TRUE(a.init(test::sim_options(5), s, 21));
   test::CollectPoses sa;
@@ -413,6 +414,7 @@ TEST(SdpSlam, skeleton_work_per_scan_stays_within_the_budget) {
   SdpOptions s = test::small_sdp_options();
   s.work_cells_per_scan = 4096U;
   s.max_levels = capacity::kMaxPgsLevels;  // no level becomes permanent: no map transfer
+  s.map_observation_capacity = 1000000U;   // ... nor for the pool's room
   test::SdpRig rig;
   CHECK_TRUE(rig.init(test::sim_options(5), s, 21));
   std::uint32_t most = 0U;
@@ -535,6 +537,7 @@ TEST(SdpSlam, tiny_capacities_are_counted_and_survived) {
   b.map_observations_base = 2000U;  // the DP map runs out
   b.map_observations_per_particle = 500U;
   SdpOptions s = test::small_sdp_options();
+  s.map_observation_capacity = 0U;  // the bottom options' size
   s.top_particles = 1U;
   s.max_levels = 2U;
   s.max_permanent_submaps = 1U;  // the permanent ring forgets
@@ -548,6 +551,40 @@ TEST(SdpSlam, tiny_capacities_are_counted_and_survived) {
   CHECK(st.permanent_forgotten > 0U);
   CHECK(st.skeleton_truncated_points > 0U || st.skeletons > 0U);
   CHECK(st.levels_made_permanent > 0U);
+  CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
+  CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+  CHECK_TRUE(rig.slam->graph().invariants_hold());
+  CHECK(t.poses.size() > 100U);
+}
+
+// The DP map's observation pool sized at half of what a run's live levels hold at their
+// peak: older levels become permanent early (and a segment ends when the pool cannot
+// take another scan) instead of the pool refusing the current segment's map updates.
+TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_refusing_updates) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  std::uint32_t peak = 0U;
+  {
+    test::SdpRig rig;
+    CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+    test::CollectPoses sink;
+    run_sdp(rig, set, &sink);
+    const DpMap& map = rig.slam->bottom().map();
+    peak = map.observations_peak();
+    LONGS_EQUAL(0, map.observation_oom_count());
+    LONGS_EQUAL(0, rig.slam->stats().levels_made_permanent_for_room);
+    LONGS_EQUAL(0, rig.slam->stats().pool_segmentations);
+  }
+  s.map_observation_capacity = peak / 2U;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+  test::CollectPoses sink;
+  const Trace t = run_sdp(rig, set, &sink);
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.levels_made_permanent_for_room > 0U);
+  LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+  LONGS_EQUAL(0, rig.slam->bottom().stats().map_updates_dropped);
+  LONGS_EQUAL(st.segments - st.levels_made_permanent, rig.slam->graph().live_level_count());
   CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
   CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
   CHECK_TRUE(rig.slam->graph().invariants_hold());

@@ -298,6 +298,7 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
     node_owner_[particle] = owner;
   }
   Observation* o = static_cast<Observation*>(obs_pool_.allocate());  // cannot fail: checked above
+  ++observations_made_;
   const std::uint32_t e = obs_pool_.index_of(o);
   obs_ = o - e;
   Tile& tile = tiles_[slot];

@@ -11,6 +11,7 @@ const char* to_string(SegmentEnd reason) {
     case SegmentEnd::kDispersion: return "dispersion";
     case SegmentEnd::kMaxLength: return "max_length";
     case SegmentEnd::kWindow: return "window";
+    case SegmentEnd::kPool: return "pool";
   }
   return "?";
 }

@@ -257,8 +257,10 @@ std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::si
   };
   std::string js;
   js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
-  js += "  \"window_segmentations\": " + u(st.window_segmentations) + ",\n";
-  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"submaps_released\": " +
+  js += "  \"window_segmentations\": " + u(st.window_segmentations) + ",\n  \"pool_segmentations\": " +
+        u(st.pool_segmentations) + ",\n";
+  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"levels_made_permanent_for_room\": " +
+        u(st.levels_made_permanent_for_room) + ",\n  \"submaps_released\": " +
         u(st.submaps_released) + ",\n";
   js += "  \"global_map_transfers\": {\"cells\": " + u(st.map_transfer_cells) + ", \"popped\": " +
         u(st.map_transfers_popped) + ", \"by_rows\": " + u(st.map_transfers_by_rows) +

@@ -53,7 +53,12 @@
 // cell tagged with the level that put it there) and its skeleton into a ring of permanent
 // submaps (still matched for loop closures); the level's other submaps are released
 // (set_active(false) + prune frees their DP-map observations; counted), one submap per
-// call of process() so that no single scan pays for all of them.
+// call of process() so that no single scan pays for all of them. The DP map's
+// observation pool bounds the live levels too: a segment ends (SegmentEnd::kPool) when
+// the pool could not take another scan's writes, and at a segmentation older levels
+// become permanent early, released at once, until the next segment's expected need
+// fits (make_room(); counted as levels_made_permanent_for_room). A full pool would
+// instead refuse the current segment's own map updates.
 //
 // Loop closure (beyond the paper, SdpOptions::loop_closure; loop_closure.h): every
 // skeleton ICP match of two non-adjacent submaps is handed to LoopClosure::refine, which
@@ -108,8 +113,10 @@ struct SdpStats : LoopClosureStats {
   std::uint64_t segments = 0U;            // segmentations done (levels added)
   std::uint64_t restart_refused = 0U;     // segmentation postponed: no room to restart
   std::uint64_t window_segmentations = 0U;  // segments ended at the edge of their DP-map square
+  std::uint64_t pool_segmentations = 0U;    // ... when the DP map's pool could not take another scan
   std::uint64_t pgs_refused = 0U;         // add_level refused (should stay 0)
   std::uint64_t levels_made_permanent = 0U;
+  std::uint64_t levels_made_permanent_for_room = 0U;  // ... early, to fit the next segment's map (pool)
   std::uint64_t submaps_released = 0U;    // submaps freed when their level became permanent
   std::uint64_t permanent_forgotten = 0U; // permanent skeletons dropped from the ring
   std::uint64_t skeletons = 0U;
@@ -374,6 +381,8 @@ class SdpSlam {
   CellRect rect_around(double x0, double y0, double x1, double y1, double pad_m) const;
 
   void segment(std::int64_t stamp_us);
+  std::uint64_t observations_needed() const;
+  void make_room(std::uint64_t need);
   void make_oldest_permanent();
   std::uint32_t do_work(std::uint32_t budget_cells);
   // The whole skeleton now (completing any other job first); returns cells read.
@@ -483,6 +492,18 @@ class SdpSlam {
   Pose2 segment_start_pose_{};     // restart pose (current segment's initial pose)
   double window_radius_m_ = 0.0;   // a segment ends when its path leaves this disc (1/8 window)
   std::int64_t segment_start_stamp_us_ = 0;  // exclusive
+  std::uint32_t segment_scans_ = 0U;  // processed scans in the current segment
+  // DP map observations asked for by one processed scan: the most in this segment, and
+  // in the previous one.
+  std::uint64_t scan_requests_ = 0U;
+  std::uint64_t previous_scan_requests_ = 0U;
+  // DP map observations freed by releasing permanent levels' submaps (release_one,
+  // transfer_rows), ever; and, when the current segment started, that count and the
+  // observations in use and refused then (observations_needed()).
+  std::uint64_t observations_released_ = 0U;
+  std::uint64_t segment_observations_released_ = 0U;
+  std::uint64_t segment_observations_used_ = 0U;
+  std::uint64_t segment_observations_refused_ = 0U;
   std::int64_t last_processed_stamp_us_ = 0;
   double seg_box_[4] = {0.0, 0.0, 0.0, 0.0};  // best poses of the current segment
   // Top-level round.

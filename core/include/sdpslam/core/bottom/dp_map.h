@@ -236,6 +236,10 @@ class DpMap final : public TreeListener {
   std::uint32_t observation_capacity() const { return obs_pool_.capacity(); }
   std::uint64_t tile_oom_count() const { return tile_oom_count_; }
   std::uint64_t observation_oom_count() const { return observation_oom_count_; }
+  // New (node, cell) observations asked for since init: made, or refused for a full pool.
+  // Over one filter step, what the step needed of the pool at once (before merges of
+  // single-child nodes gave most of it back).
+  std::uint64_t observations_requested() const { return observations_made_ + observation_oom_count_; }
   std::uint64_t out_of_bounds_count() const { return out_of_bounds_count_; }
   std::uint64_t misuse_count() const { return misuse_count_; }
   // Bytes of state: tile table, tile pool, observation pool, owner tables, index.
@@ -367,6 +371,7 @@ class DpMap final : public TreeListener {
   std::uint32_t touched_tx0_ = kNone, touched_ty0_ = kNone, touched_tx1_ = 0U, touched_ty1_ = 0U;
   std::uint64_t tile_oom_count_ = 0U;
   std::uint64_t observation_oom_count_ = 0U;
+  std::uint64_t observations_made_ = 0U;
   std::uint64_t out_of_bounds_count_ = 0U;
   std::uint64_t misuse_count_ = 0U;
 };
