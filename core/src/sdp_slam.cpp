@@ -379,8 +379,7 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
       // scan as new observations before prune folds them into its lineage): the segment
       // ends, and make_room() frees older levels.
       const DpMap& map = filter_->map();
-      const std::uint64_t next = scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
-      if (std::uint64_t{map.observation_capacity() - map.observations_used()} < next) end = SegmentEnd::kPool;
+      if (std::uint64_t{map.observation_capacity() - map.observations_used()} < scan_burst()) end = SegmentEnd::kPool;
     }
     if (end != SegmentEnd::kNone) {
       const std::uint64_t before = stats_.segments;
@@ -534,8 +533,7 @@ std::uint64_t SdpSlam::observations_needed() const {
   const DpMap& map = filter_->map();
   const std::uint64_t grown_to = std::uint64_t{map.observations_used()} + (observations_released_ - segment_observations_released_);
   const std::uint64_t grown = grown_to > segment_observations_used_ ? grown_to - segment_observations_used_ : 0U;
-  const std::uint64_t burst = scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
-  return grown + (map.observation_oom_count() - segment_observations_refused_) + burst;
+  return grown + (map.observation_oom_count() - segment_observations_refused_) + scan_burst();
 }
 
 void SdpSlam::make_room(std::uint64_t need) {
@@ -544,24 +542,31 @@ void SdpSlam::make_room(std::uint64_t need) {
     return std::uint64_t{map.observations_used()} + need > std::uint64_t{map.observation_capacity()};
   };
   if (!short_of_room()) return;
-  while (release_count_ > 0U) release_one();
-  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+  finish_releases();
   while (short_of_room() && graph_.live_level_count() > 0U) {
     const std::uint64_t before = stats_.levels_made_permanent;
     make_oldest_permanent();
     if (stats_.levels_made_permanent == before) return;
-    while (release_count_ > 0U) release_one();
-    while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+    finish_releases();
     ++stats_.levels_made_permanent_for_room;
   }
+}
+
+std::uint64_t SdpSlam::scan_burst() const {
+  return scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
+}
+
+// The pending releases and the permanent submap's copy, all now.
+void SdpSlam::finish_releases() {
+  while (release_count_ > 0U) release_one();
+  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
 }
 
 void SdpSlam::make_oldest_permanent() {
   const std::uint32_t level = graph_.first_live_level();
   if (!graph_.is_live(level)) return;
   // Pending work first (the previous level's releases and transfer, this level's skeletons).
-  while (release_count_ > 0U) release_one();
-  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+  finish_releases();
   const std::uint32_t count = levels_[slot(level)].count;
   for (std::uint32_t k = 0; k < count; ++k) {
     if (!submap(level, k).skeleton_done) extract_skeleton(level, k);

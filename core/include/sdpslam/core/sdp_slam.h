@@ -383,6 +383,9 @@ class SdpSlam {
   void segment(std::int64_t stamp_us);
   std::uint64_t observations_needed() const;
   void make_room(std::uint64_t need);
+  // The most DP map observations one processed scan asked for, in this segment or the previous one.
+  std::uint64_t scan_burst() const;
+  void finish_releases();
   void make_oldest_permanent();
   std::uint32_t do_work(std::uint32_t budget_cells);
   // The whole skeleton now (completing any other job first); returns cells read.
