@@ -32,7 +32,7 @@ as_root() {
 host_pkgs=(cmake ninja-build g++ pkg-config libcpputest-dev libpng-dev zlib1g-dev
            libcli11-dev libinih-dev)
 test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils
-           dpkg-dev binutils lintian)
+           dpkg-dev binutils lintian systemd)
 arm64_pkgs=(libcpputest-dev:arm64)
 # Target libraries of the arm64 package build (tests/packaging). Optional: when the mirror's
 # arm64 indexes lag amd64 this install fails, and the tests unpack the same packages with

@@ -227,6 +227,7 @@ void Daemon::step() {
     write_outputs();
     next_output_us_ = io_.clock->now_us() + config_.output_period_us;
   }
+  if (io_.watchdog != nullptr) io_.watchdog->pat();
 }
 
 bool Daemon::run(const volatile std::sig_atomic_t* stop, volatile std::sig_atomic_t* localize) {

@@ -8,6 +8,7 @@
 // written, 1 internal failure, 2 bad command line, 3 bad configuration or input,
 // 4 an output could not be written (output directory at start, final outputs at exit).
 #include <signal.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +26,7 @@
 #include "sdpslam/drivers/serial_port.h"
 #include "sdpslam/drivers/sick_lms2xx_laser.h"
 #include "sdpslam/drivers/socketcan_bus.h"
+#include "sdpslam/drivers/systemd_notifier.h"
 #include "sdpslam/drivers/urg_scip2_laser.h"
 
 namespace {
@@ -162,6 +164,11 @@ int run_daemon(int argc, char** argv) {
 
   drivers::LinuxMonotonicClock clock;
   daemon::EventLog log(clock, config.log_interval_us);
+  // Under a Type=notify unit: READY=1 once the loop can start, WATCHDOG=1 from the loop.
+  drivers::SystemdNotifier notifier(drivers::NotifyEnvironment::from_process(), clock, static_cast<long>(::getpid()));
+  if (!notifier.setup_error().empty()) {
+    std::fprintf(stderr, "sdpslamd: warning: service notification: %s\n", notifier.setup_error().c_str());
+  }
   std::unique_ptr<daemon::SlamEngine> engine = daemon::make_engine(config, &error);
   if (!engine) {
     std::fprintf(stderr, "sdpslamd: %s: %s\n", config_path.c_str(), error.c_str());
@@ -233,13 +240,32 @@ int run_daemon(int argc, char** argv) {
   io.laser = laser.get();
   io.laser_stream = &port;
   io.engine = engine.get();
+  io.watchdog = &notifier;
   auto d = std::make_unique<daemon::Daemon>(config, io, log);
   d->adopt_engine(std::move(engine));
   if (!d->start(&error)) {
     std::fprintf(stderr, "sdpslamd: %s\n", error.c_str());
     return kExitIo;
   }
+  if (notifier.enabled()) {
+    char status[200];
+    std::snprintf(status, sizeof status, "running: %s, outputs in %s%s", daemon::to_string(config.mode),
+                  config.output_directory.c_str(),
+                  notifier.watchdog_timeout_us() > 0 ? ", watchdog on" : "");
+    if (!notifier.ready(status)) {
+      log.log(daemon::Event::kStartup, "the service manager was not told that sdpslamd is ready: %s",
+              notifier.last_error().c_str());
+    } else if (notifier.watchdog_timeout_us() > 0) {
+      log.log(daemon::Event::kStartup, "service watchdog: the loop reports at least every %.1f s",
+              static_cast<double>(notifier.watchdog_timeout_us()) * 0.5e-6);
+    }
+  }
   const bool ok = d->run(&g_stop, &g_localize);
+  notifier.stopping();
+  if (notifier.failures() > 0U) {
+    std::fprintf(stderr, "sdpslamd: %llu service notifications not sent (last: %s)\n",
+                 static_cast<unsigned long long>(notifier.failures()), notifier.last_error().c_str());
+  }
   const daemon::DaemonCounters& c = d->counters();
   const daemon::LatencyFigures lf = d->latency_from_stamp();
   std::fprintf(stderr,

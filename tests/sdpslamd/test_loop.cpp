@@ -111,6 +111,12 @@ class FakeEngine final : public SlamEngine {
   io::OccupancyImage map;  // what the engine "mapped" (empty by default)
 };
 
+class CountingWatchdog final : public hal::Watchdog {
+ public:
+  void pat() override { ++pats; }
+  int pats = 0;
+};
+
 // 2000 ticks per revolution, radius 0.077 m: 1000 ticks on both wheels = 0.2419 m ahead.
 constexpr double kMetresPer1000Ticks = 0.077 * 3.14159265358979323846;
 
@@ -120,6 +126,7 @@ struct Rig {
   FakeLaser laser;
   FakeBus bus;
   FakeEngine engine;
+  CountingWatchdog watchdog;
   std::FILE* log_file = std::tmpfile();
   EventLog log{clock, 0, log_file};
   DaemonConfig config;
@@ -140,6 +147,7 @@ struct Rig {
     io.encoders = &enc;
     io.laser = &laser;
     io.engine = &engine;
+    io.watchdog = &watchdog;
     d = std::make_unique<Daemon>(config, io, log);
     std::string error;
     CHECK_TRUE_TEXT(d->start(&error), error.c_str());
@@ -408,4 +416,18 @@ TEST(SdpslamdLoop, a_switch_to_localization_keeps_the_session_map_and_localizes_
   LONGS_EQUAL(fed_to_mapping, r.engine.got.size());  // the mapping engine gets no more scans
   CHECK_FALSE(d.switch_to_localization(&error));
   STRCMP_CONTAINS("already localizing", error.c_str());
+}
+
+// Every pass of the loop reports to the watchdog, with or without sensors: a supervisor
+// hears from a running loop whatever the robot's hardware does, and only from it.
+TEST(SdpslamdLoop, every_step_pats_the_watchdog_whether_or_not_the_sensors_answer) {
+  Rig r;
+  r.make();
+  LONGS_EQUAL(0, r.watchdog.pats);
+  r.scan_between_odometry(0, 1000000);
+  LONGS_EQUAL(2, r.watchdog.pats);
+  r.laser.unplug();
+  r.bus.s = hal::CanBusState::kBusOff;
+  for (int i = 0; i < 5; ++i) r.d->step();
+  LONGS_EQUAL(7, r.watchdog.pats);
 }

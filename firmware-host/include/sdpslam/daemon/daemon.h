@@ -21,6 +21,7 @@
 //   6. every output_period_us writes trajectory.txt/.tum, map.pgm/.yaml/.png and status.json
 //      into the output directory, each atomically (a failed write keeps the previous file
 //      and is logged and counted; the next period tries again).
+//   7. pats the watchdog (DaemonIo::watchdog), when there is one.
 // run() steps until *stop becomes non-zero (SIGINT/SIGTERM), places what can still be
 // placed, and writes the final outputs. When *localize becomes non-zero (SIGUSR1) it
 // switches from mapping to localization on the map just built
@@ -46,6 +47,7 @@
 #include "sdpslam/hal/can_bus.h"
 #include "sdpslam/hal/clock.h"
 #include "sdpslam/hal/range_scan_source.h"
+#include "sdpslam/hal/watchdog.h"
 #include "sdpslam/hal/wheel_encoder_source.h"
 #include "sdpslam/io/output_set.h"
 
@@ -88,6 +90,9 @@ struct DaemonIo {
   hal::RangeScanSource* laser = nullptr;
   const hal::ByteStream* laser_stream = nullptr;  // stats only; may be null
   SlamEngine* engine = nullptr;
+  // Patted at the end of every step(), so that a supervisor restarts a loop that hangs
+  // (hal/watchdog.h; on the robot systemd's WatchdogSec=); may be null.
+  hal::Watchdog* watchdog = nullptr;
 };
 
 class Daemon {
