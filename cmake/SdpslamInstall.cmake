@@ -202,7 +202,7 @@ sdpslam::drivers and sdpslam::io. The libraries are static: the core is
 linked into the robot's firmware.")
 # The CMake package finds these (sdpslamConfig.cmake); the core needs nothing.
 if(SDPSLAM_EXPORTS_IO)
-  set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, zlib1g-dev")
+  set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, nlohmann-json3-dev, zlib1g-dev")
 endif()
 
 # Depends of the programs. Natively dpkg-shlibdeps computes them from the binaries. A

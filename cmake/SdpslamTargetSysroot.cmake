@@ -18,7 +18,7 @@ if(CMAKE_CROSSCOMPILING AND SDPSLAM_TARGET_SYSROOT)
   if(IS_DIRECTORY "${_sysroot_libdir}")
     message(STATUS "Target libraries from ${SDPSLAM_TARGET_SYSROOT} (compiler sysroot unchanged)")
     # find_library/find_path/find_package look in the folder first, then in the usual
-    # places (mode BOTH), so header-only host packages (CLI11) are still found.
+    # places (mode BOTH), so header-only host packages (CLI11, nlohmann-json) are still found.
     list(APPEND CMAKE_FIND_ROOT_PATH "${SDPSLAM_TARGET_SYSROOT}")
     # pkg-config (inih): the folder's .pc files come first, and the -I/-L paths they name
     # (/usr/...) are rewritten into the folder.
