@@ -175,6 +175,7 @@ contents)
         libpng16.so.*) pkg=libpng16-16 ;;
         libz.so.*) pkg=zlib1g ;;
         libinih.so.*) pkg=libinih1 ;;
+        libyaml-cpp.so.0.7) pkg=libyaml-cpp0.7 ;;
         *) bad "$(basename "$bin") needs $so, which this test cannot map to a package"; continue ;;
       esac
       printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/ .*//' | grep -qx "$pkg" \

@@ -17,6 +17,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "shared_data.h"
+#include "yaml_statics.h"  // localize mode reads a map YAML
 
 using namespace sdpslam;
 using namespace sdpslam::daemon;

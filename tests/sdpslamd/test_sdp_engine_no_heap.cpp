@@ -15,6 +15,7 @@
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/io/map_image.h"
 #include "shared_data.h"
+#include "yaml_statics.h"  // localize mode reads a map YAML
 
 using sdpslam::daemon::DaemonConfig;
 

@@ -42,6 +42,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/map_read.h"
 #include "sdpslam/io/trajectory_io.h"
 
 namespace sdpslam::cli {
@@ -280,7 +281,7 @@ int run_map_agreement(const EvaluateArgs& a, io::Json* json) {
   io::OccupancyImage map;
   io::MapWriteOptions thresholds;
   std::string error;
-  if (!io::read_map_pgm_yaml(a.map_path, &map, &thresholds, &error)) {
+  if (!io::read_map_yaml(a.map_path, &map, &thresholds, &error)) {
     std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
     return kExitBadInput;
   }

@@ -13,6 +13,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/map_read.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/slam/slam_outputs.h"
 
@@ -22,8 +23,9 @@ namespace {
 using detail::percentile;
 using detail::thread_cpu_ms;
 
-// The map's classes as map_server reads them (io::read_map_pgm_yaml: occupancy above
-// occupied_thresh, below free_thresh, else unknown = -1).
+// The map's classes as map_server reads them (io::read_map_yaml: occupancy above
+// occupied_thresh, below free_thresh, else unknown: -1, or between the thresholds in
+// mode scale).
 std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::MapWriteOptions& t) {
   std::vector<std::uint8_t> cells(img.occupancy.size(), LocalizerMap::kUnknown);
   for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -39,7 +41,7 @@ std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::Map
 
 bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error) {
   io::MapWriteOptions thresholds;
-  if (!io::read_map_pgm_yaml(map_yaml, &out->image, &thresholds, error)) return false;
+  if (!io::read_map_yaml(map_yaml, &out->image, &thresholds, error)) return false;
   out->cells = map_cells(out->image, thresholds);
   out->map = LocalizerMap{};
   out->map.width = out->image.width;
