@@ -1,9 +1,11 @@
 # Target-architecture libraries for cross builds that cannot use Debian multiarch.
 #
-# The cross builds of the tools and of sdpslamd need libpng, zlib and inih for the target
-# architecture. The usual way is multiarch (`apt-get install libpng-dev:arm64`), but that
-# fails whenever the mirror's foreign-architecture indexes lag the host's (Multi-Arch:
-# same packages such as libc6-dev must have identical versions on every architecture).
+# The cross builds of the tools and of sdpslamd need libpng, zlib, inih and yaml-cpp for
+# the target architecture. The usual way is multiarch (`apt-get install libpng-dev:arm64`),
+# but that fails whenever the mirror's foreign-architecture indexes lag the host's
+# (Multi-Arch: same packages such as libc6-dev must have identical versions on every
+# architecture), and libyaml-cpp-dev cannot be installed beside the build machine's own
+# at all (it is not Multi-Arch: same).
 # cmake/fetch-target-sysroot.sh then unpacks the target's .deb files (apt-get download +
 # dpkg -x) into a folder, and SDPSLAM_TARGET_SYSROOT points at it.
 #
