@@ -202,7 +202,7 @@ sdpslam::drivers and sdpslam::io. The libraries are static: the core is
 linked into the robot's firmware.")
 # The CMake package finds these (sdpslamConfig.cmake); the core needs nothing.
 if(SDPSLAM_EXPORTS_IO)
-  set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, zlib1g-dev")
+  set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libpng-dev, libyaml-cpp-dev, nlohmann-json3-dev, zlib1g-dev")
 endif()
 
 # Depends of the programs. Natively dpkg-shlibdeps computes them from the binaries. A
@@ -210,7 +210,7 @@ endif()
 # build machine's dpkg), so the list is stated; the packaging test checks it against the
 # binaries' DT_NEEDED entries and against what dpkg-shlibdeps finds for amd64.
 set(SDPSLAM_DEB_CROSS_DEPENDS
-  "libc6 (>= 2.35), libgcc-s1 (>= 3.0), libinih1 (>= 40), libpng16-16 (>= 1.6.2-1), libstdc++6 (>= 11), zlib1g (>= 1:1.2.6)"
+  "libc6 (>= 2.35), libgcc-s1 (>= 3.0), libinih1 (>= 40), libpng16-16 (>= 1.6.2-1), libstdc++6 (>= 11), libyaml-cpp0.7 (>= 0.7.0), zlib1g (>= 1:1.2.6)"
   CACHE STRING "Depends of the sdpslam package in cross builds (dpkg-shlibdeps is used natively)")
 if(CMAKE_CROSSCOMPILING)
   set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "${SDPSLAM_DEB_CROSS_DEPENDS}")

@@ -1,9 +1,11 @@
 # Target-architecture libraries for cross builds that cannot use Debian multiarch.
 #
-# The cross builds of the tools and of sdpslamd need libpng, zlib and inih for the target
-# architecture. The usual way is multiarch (`apt-get install libpng-dev:arm64`), but that
-# fails whenever the mirror's foreign-architecture indexes lag the host's (Multi-Arch:
-# same packages such as libc6-dev must have identical versions on every architecture).
+# The cross builds of the tools and of sdpslamd need libpng, zlib, inih and yaml-cpp for
+# the target architecture. The usual way is multiarch (`apt-get install libpng-dev:arm64`),
+# but that fails whenever the mirror's foreign-architecture indexes lag the host's
+# (Multi-Arch: same packages such as libc6-dev must have identical versions on every
+# architecture), and libyaml-cpp-dev cannot be installed beside the build machine's own
+# at all (it is not Multi-Arch: same).
 # cmake/fetch-target-sysroot.sh then unpacks the target's .deb files (apt-get download +
 # dpkg -x) into a folder, and SDPSLAM_TARGET_SYSROOT points at it.
 #
@@ -18,7 +20,7 @@ if(CMAKE_CROSSCOMPILING AND SDPSLAM_TARGET_SYSROOT)
   if(IS_DIRECTORY "${_sysroot_libdir}")
     message(STATUS "Target libraries from ${SDPSLAM_TARGET_SYSROOT} (compiler sysroot unchanged)")
     # find_library/find_path/find_package look in the folder first, then in the usual
-    # places (mode BOTH), so header-only host packages (CLI11) are still found.
+    # places (mode BOTH), so header-only host packages (CLI11, nlohmann-json) are still found.
     list(APPEND CMAKE_FIND_ROOT_PATH "${SDPSLAM_TARGET_SYSROOT}")
     # pkg-config (inih): the folder's .pc files come first, and the -I/-L paths they name
     # (/usr/...) are rewritten into the folder.

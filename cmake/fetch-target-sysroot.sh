@@ -2,7 +2,8 @@
 # fetch-target-sysroot.sh ARCH DIR
 #
 # Unpacks the target architecture's libraries that the tools and sdpslamd link against
-# (libpng, zlib, inih: headers, .so links, pkg-config files and the runtime libraries)
+# (libpng, zlib, inih, yaml-cpp: headers, .so links, pkg-config and CMake files and the
+# runtime libraries)
 # into DIR, for a cross build with -DSDPSLAM_TARGET_SYSROOT=DIR (cmake/SdpslamTargetSysroot.cmake).
 #
 # Why not multiarch: `apt-get install libpng-dev:ARCH` fails whenever the mirror's ARCH
@@ -21,7 +22,7 @@ arch=$1
 dir=$2
 case "$arch" in *[!a-z0-9]*|'') usage ;; esac
 
-pkgs=(libpng-dev libpng16-16 zlib1g-dev zlib1g libinih-dev libinih1)
+pkgs=(libpng-dev libpng16-16 zlib1g-dev zlib1g libinih-dev libinih1 libyaml-cpp-dev libyaml-cpp0.7)
 
 if ! dpkg --print-foreign-architectures | grep -qx "$arch" && [ "$(dpkg --print-architecture)" != "$arch" ]; then
   echo "fetch-target-sysroot: architecture $arch is not configured; run: dpkg --add-architecture $arch && apt-get update" >&2

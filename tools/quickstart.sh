@@ -30,14 +30,18 @@ as_root() {
 
 # Packages for the host build and tests; cross and fuzz extras for `test`.
 host_pkgs=(cmake ninja-build g++ pkg-config libcpputest-dev libpng-dev zlib1g-dev
-           libcli11-dev libinih-dev)
+           libcli11-dev libinih-dev nlohmann-json3-dev libyaml-cpp-dev)
 test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils
            dpkg-dev binutils lintian systemd)
 arm64_pkgs=(libcpputest-dev:arm64)
 # Target libraries of the arm64 package build (tests/packaging). Optional: when the mirror's
 # arm64 indexes lag amd64 this install fails, and the tests unpack the same packages with
-# apt-get download + dpkg -x instead (cmake/fetch-target-sysroot.sh).
-arm64_packaging_pkgs=(libpng-dev:arm64 zlib1g-dev:arm64 libinih-dev:arm64)
+# apt-get download + dpkg -x instead (cmake/fetch-target-sysroot.sh). libyaml-cpp-dev is
+# not among them: it cannot be installed for two architectures at once (not Multi-Arch:
+# same), so the arm64 one always comes from a folder that script unpacks (the packaging
+# tests make their own; the aarch64 preset reads build/sysroot-arm64, made below). Its
+# shared library can, and the aarch64 tests load it under qemu.
+arm64_packaging_pkgs=(libpng-dev:arm64 zlib1g-dev:arm64 libinih-dev:arm64 libyaml-cpp0.7:arm64)
 
 missing() {
   local p out=()
@@ -101,9 +105,12 @@ case "$mode" in
     fi
     install "${host_pkgs[@]}" "${test_pkgs[@]}" "${arm64_pkgs[@]}"
     install "${arm64_packaging_pkgs[@]}" 2>/dev/null \
-      || echo "quickstart: multiarch arm64 libpng/zlib/inih did not install; the packaging tests will unpack them into a sysroot" >&2
-    [ -d ../shared ] || echo "quickstart: ../shared is absent: tests that need the benchmark logs and sensor captures will be reported as skipped" >&2
+      || echo "quickstart: multiarch arm64 libpng/zlib/inih/yaml-cpp did not install; the packaging tests will unpack them into a sysroot" >&2
     mkdir -p build
+    # The aarch64 build of sdpslamd needs the target's yaml-cpp (see arm64_packaging_pkgs).
+    bash cmake/fetch-target-sysroot.sh arm64 build/sysroot-arm64 \
+      || echo "quickstart: the arm64 libraries could not be unpacked into build/sysroot-arm64; the aarch64 preset will build without sdpslamd" >&2
+    [ -d ../shared ] || echo "quickstart: ../shared is absent: tests that need the benchmark logs and sensor captures will be reported as skipped" >&2
     start=$(date +%s)
     failed=()
     for preset in host-debug host-asan aarch64 fuzz; do

@@ -9,8 +9,10 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/slam/slam_outputs.h"
 
@@ -33,11 +35,8 @@ const char* health_name(hal::RangeSourceHealth h) {
   return "?";
 }
 
-std::string fmt_ms(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f", v);
-  return b;
-}
+// Seconds and milliseconds to the microsecond, coordinates to the millimetre.
+double fixed3(double v) { return io::json_fixed(v, 3); }
 
 }  // namespace
 
@@ -371,62 +370,83 @@ std::string Daemon::status_json() const {
   const double user_s = static_cast<double>(ru.ru_utime.tv_sec) + static_cast<double>(ru.ru_utime.tv_usec) * 1e-6;
   const double sys_s = static_cast<double>(ru.ru_stime.tv_sec) + static_cast<double>(ru.ru_stime.tv_usec) * 1e-6;
   const double up_s = static_cast<double>(now - start_us_) * 1e-6;
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
-  auto lat = [&](const LatencyFigures& f) {
-    return "{\"count\": " + u(f.count) + ", \"p50\": " + fmt_ms(f.p50_ms) + ", \"p99\": " + fmt_ms(f.p99_ms) +
-           ", \"max\": " + fmt_ms(f.max_ms) + "}";
+  auto lat = [](const LatencyFigures& f) {
+    return io::Json{{"count", f.count}, {"p50", fixed3(f.p50_ms)}, {"p99", fixed3(f.p99_ms)}, {"max", fixed3(f.max_ms)}};
   };
   const DaemonCounters& c = counters_;
   const hal::RangeSourceStats& ls = io_.laser->stats();
   const hal::OdometryReading od = odom_.latest();
-  std::string js = "{\n";
-  js += "  \"program\": \"sdpslamd\",\n  \"mode\": \"" + std::string(io_.engine->name()) + "\",\n";
-  js += "  \"uptime_s\": " + fmt_ms(up_s) + ",\n";
-  js += "  \"health\": {\"laser\": \"" + std::string(health_name(io_.laser->health())) + "\", \"can\": \"" +
-        std::string(io_.bus != nullptr ? hal::to_string(io_.bus->state()) : "none") + "\", \"odometry\": \"" +
-        hal::to_string(od.status) + "\"},\n";
-  js += "  \"scans\": {\"received\": " + u(c.scans_received) + ", \"placed\": " + u(c.scans_placed) +
-        ", \"processed\": " + u(c.scans_processed) + ", \"skipped_no_odometry\": " + u(c.scans_skipped_no_odometry) +
-        ", \"skipped_too_old\": " + u(c.scans_skipped_too_old) + ", \"skipped_gap\": " + u(c.scans_skipped_gap) +
-        ", \"dropped_queue_full\": " + u(c.scans_dropped_queue_full) + ", \"dropped_total\": " + u(c.scans_dropped()) +
-        ", \"queued\": " + u(queue_.size()) + "},\n";
-  js += "  \"latency_ms\": {\"from_scan_stamp\": " + lat(latency_from_stamp()) + ", \"from_driver_read\": " +
-        lat(latency_from_read()) + ", \"max_odometry_wait\": " +
-        fmt_ms(static_cast<double>(c.max_odometry_wait_us) / 1000.0) + "},\n";
-  js += "  \"odometry\": {\"samples\": " + u(c.odometry_samples) + ", \"stale_events\": " + u(c.odometry_stale_events) +
-        ", \"wheel_pairs\": " + u(paired_.pairs_published()) + ", \"drain_stale_overrides\": " + u(paired_.drain_stale_overrides()) + ", \"relatches\": " + u(odom_.relatch_count()) + ", \"ring_breaks\": " + u(ring_.break_count()) +
-        ", \"x_m\": " + fmt_ms(od.pose.x_m) + ", \"y_m\": " + fmt_ms(od.pose.y_m) + ", \"heading_rad\": " +
-        fmt_ms(od.pose.heading_rad) + "},\n";
-  js += "  \"laser\": {\"scans\": " + u(ls.scan_count) + ", \"rejected\": " + u(ls.dropped_scan_count) +
-        ", \"checksum_errors\": " + u(ls.checksum_error_count) + ", \"framing_errors\": " +
-        u(ls.framing_error_count) + ", \"timeouts\": " + u(ls.timeout_count) + ", \"stalls\": " + u(ls.stall_count) +
-        ", \"disconnects\": " + u(ls.disconnect_count) + ", \"restarts\": " + u(ls.restart_count);
+  io::Json js;
+  js["program"] = "sdpslamd";
+  js["mode"] = io_.engine->name();
+  js["uptime_s"] = fixed3(up_s);
+  js["health"] = {{"laser", health_name(io_.laser->health())},
+                  {"can", io_.bus != nullptr ? hal::to_string(io_.bus->state()) : "none"},
+                  {"odometry", hal::to_string(od.status)}};
+  js["scans"] = {{"received", c.scans_received},
+                 {"placed", c.scans_placed},
+                 {"processed", c.scans_processed},
+                 {"skipped_no_odometry", c.scans_skipped_no_odometry},
+                 {"skipped_too_old", c.scans_skipped_too_old},
+                 {"skipped_gap", c.scans_skipped_gap},
+                 {"dropped_queue_full", c.scans_dropped_queue_full},
+                 {"dropped_total", c.scans_dropped()},
+                 {"queued", queue_.size()}};
+  js["latency_ms"] = {{"from_scan_stamp", lat(latency_from_stamp())},
+                      {"from_driver_read", lat(latency_from_read())},
+                      {"max_odometry_wait", fixed3(static_cast<double>(c.max_odometry_wait_us) / 1000.0)}};
+  js["odometry"] = {{"samples", c.odometry_samples},
+                    {"stale_events", c.odometry_stale_events},
+                    {"wheel_pairs", paired_.pairs_published()},
+                    {"drain_stale_overrides", paired_.drain_stale_overrides()},
+                    {"relatches", odom_.relatch_count()},
+                    {"ring_breaks", ring_.break_count()},
+                    {"x_m", fixed3(od.pose.x_m)},
+                    {"y_m", fixed3(od.pose.y_m)},
+                    {"heading_rad", fixed3(od.pose.heading_rad)}};
+  io::Json laser = {{"scans", ls.scan_count},
+                    {"rejected", ls.dropped_scan_count},
+                    {"checksum_errors", ls.checksum_error_count},
+                    {"framing_errors", ls.framing_error_count},
+                    {"timeouts", ls.timeout_count},
+                    {"stalls", ls.stall_count},
+                    {"disconnects", ls.disconnect_count},
+                    {"restarts", ls.restart_count}};
   if (io_.laser_stream != nullptr) {
     const hal::ByteStreamStats& bs = io_.laser_stream->stats();
-    js += ", \"opens\": " + u(bs.open_count) + ", \"hangups\": " + u(bs.hangup_count);
+    laser["opens"] = bs.open_count;
+    laser["hangups"] = bs.hangup_count;
   }
-  js += "},\n";
+  js["laser"] = std::move(laser);
   if (io_.bus != nullptr) {
     const hal::CanBusStats& cs = io_.bus->stats();
-    js += "  \"can\": {\"rx_frames\": " + u(cs.rx_frames) + ", \"tx_frames\": " + u(cs.tx_frames) +
-          ", \"rx_overflows\": " + u(cs.rx_overflows) + ", \"error_frames\": " + u(cs.error_frames) +
-          ", \"bus_off\": " + u(cs.errors.bus_off) + ", \"down_count\": " + u(cs.down_count) +
-          ", \"reopen_count\": " + u(cs.reopen_count) + ", \"tx_errors\": " + u(cs.tx_errors) +
-          ", \"tx_while_down\": " + u(cs.tx_while_down) + "},\n";
+    js["can"] = {{"rx_frames", cs.rx_frames},
+                 {"tx_frames", cs.tx_frames},
+                 {"rx_overflows", cs.rx_overflows},
+                 {"error_frames", cs.error_frames},
+                 {"bus_off", cs.errors.bus_off},
+                 {"down_count", cs.down_count},
+                 {"reopen_count", cs.reopen_count},
+                 {"tx_errors", cs.tx_errors},
+                 {"tx_while_down", cs.tx_while_down}};
   }
   const InputRecorderStats& rs = recorder_.stats();
-  js += "  \"input_log\": {\"enabled\": " + std::string(recorder_.is_open() ? "true" : "false") + ", \"lines\": " +
-        u(rs.lines_written) + ", \"bytes\": " + u(rs.bytes_written) + ", \"write_failures\": " +
-        u(rs.write_failures) + ", \"roundtrip_changed\": " + u(rs.changed_count) + ", \"roundtrip_failures\": " +
-        u(rs.roundtrip_failures) + "},\n";
-  js += "  \"engine\": {" + io_.engine->status_json() + "},\n";
-  js += "  \"outputs\": {\"writes\": " + u(c.output_writes) + ", \"failures\": " + u(c.output_failures) +
-        ", \"unchanged\": " + u(c.output_writes_unchanged) +
-        ", \"max_write_ms\": " + fmt_ms(static_cast<double>(c.max_output_write_us) / 1000.0) + "},\n";
-  js += "  \"events\": {\"logged\": " + u(log_.printed()) + ", \"suppressed\": " + u(log_.suppressed()) + "},\n";
-  js += "  \"cpu\": {\"user_s\": " + fmt_ms(user_s) + ", \"system_s\": " + fmt_ms(sys_s) + ", \"percent\": " +
-        fmt_ms(up_s > 0.0 ? 100.0 * (user_s + sys_s) / up_s : 0.0) + "}\n}\n";
-  return js;
+  js["input_log"] = {{"enabled", recorder_.is_open()},
+                     {"lines", rs.lines_written},
+                     {"bytes", rs.bytes_written},
+                     {"write_failures", rs.write_failures},
+                     {"roundtrip_changed", rs.changed_count},
+                     {"roundtrip_failures", rs.roundtrip_failures}};
+  js["engine"] = io_.engine->status_json();
+  js["outputs"] = {{"writes", c.output_writes},
+                   {"failures", c.output_failures},
+                   {"unchanged", c.output_writes_unchanged},
+                   {"max_write_ms", fixed3(static_cast<double>(c.max_output_write_us) / 1000.0)}};
+  js["events"] = {{"logged", log_.printed()}, {"suppressed", log_.suppressed()}};
+  js["cpu"] = {{"user_s", fixed3(user_s)},
+               {"system_s", fixed3(sys_s)},
+               {"percent", fixed3(up_s > 0.0 ? 100.0 * (user_s + sys_s) / up_s : 0.0)}};
+  return io::json_text(js);
 }
 
 }  // namespace sdpslam::daemon

@@ -1,7 +1,5 @@
 #include "sdpslam/daemon/slam_engine.h"
 
-#include <cstdio>
-
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
@@ -65,18 +63,23 @@ class DpSlamEngine final : public SlamEngine {
 
   std::uint32_t map_image(io::OccupancyImage* image) const override { return slam::best_map_image(*filter_, image); }
 
-  std::string status_json() const override {
+  io::Json status_json() const override {
     const DpSlamStats& st = filter_->stats();
     const AncestryTree& tree = filter_->tree();
     const DpMap& map = filter_->map();
-    auto u = [](std::uint64_t v) { return std::to_string(v); };
-    return "\"particles\": " + u(filter_->particle_count()) + ", \"processed\": " + u(st.processed) +
-           ", \"resamplings\": " + u(st.resamplings) + ", \"map_updates_dropped\": " + u(st.map_updates_dropped) +
-           ", \"node_fallbacks\": " + u(st.node_fallback_count) + ", \"ancestry_nodes_peak\": " + u(tree.peak_used()) +
-           ", \"ancestry_nodes_capacity\": " + u(tree.capacity()) + ", \"path_entries_exhausted\": " +
-           u(tree.path_oom_count()) + ", \"observations_peak\": " + u(map.observations_peak()) +
-           ", \"observations_capacity\": " + u(map.observation_capacity()) + ", \"arena_bytes\": " + u(arena_bytes_) +
-           ", \"committed_poses_dropped\": " + u(sink_.dropped) + ", \"unrecorded_scans\": " + u(unrecorded_);
+    return {{"particles", filter_->particle_count()},
+            {"processed", st.processed},
+            {"resamplings", st.resamplings},
+            {"map_updates_dropped", st.map_updates_dropped},
+            {"node_fallbacks", st.node_fallback_count},
+            {"ancestry_nodes_peak", tree.peak_used()},
+            {"ancestry_nodes_capacity", tree.capacity()},
+            {"path_entries_exhausted", tree.path_oom_count()},
+            {"observations_peak", map.observations_peak()},
+            {"observations_capacity", map.observation_capacity()},
+            {"arena_bytes", arena_bytes_},
+            {"committed_poses_dropped", sink_.dropped},
+            {"unrecorded_scans", unrecorded_}};
   }
 
   std::uint64_t unrecorded_scans() const override { return unrecorded_; }
@@ -144,16 +147,15 @@ class SdpEngine final : public SlamEngine {
 
   void finish() override { slam_->finish(); }
 
-  std::string status_json() const override {
-    auto u = [](std::uint64_t v) { return std::to_string(v); };
-    std::string js = "\"particles\": " + u(slam_->bottom().particle_count()) + ", \"top_particles\": " +
-                     u(slam_->options().top_particles) + ", \"processed\": " + u(slam_->bottom().stats().processed) +
-                     ", \"committed_poses_dropped\": " + u(permanent_.dropped()) + ", \"unrecorded_scans\": " +
-                     u(unrecorded_) + ",\n";
+  io::Json status_json() const override {
+    io::Json js = {{"particles", slam_->bottom().particle_count()},
+                   {"top_particles", slam_->options().top_particles},
+                   {"processed", slam_->bottom().stats().processed},
+                   {"committed_poses_dropped", permanent_.dropped()},
+                   {"unrecorded_scans", unrecorded_}};
     // The offline runner's stats.json members; trajectory gaps and known cells as of the
     // last trajectory() / map_image().
-    js += slam::sdp_state_json(*slam_, arena_bytes_, arena_->used_bytes(), path_gaps_, known_cells_);
-    while (!js.empty() && (js.back() == '\n' || js.back() == ',')) js.pop_back();
+    js.update(slam::sdp_state_json(*slam_, arena_bytes_, arena_->used_bytes(), path_gaps_, known_cells_));
     return js;
   }
 
@@ -221,15 +223,16 @@ class LocalizeEngine final : public SlamEngine {
     return mcl_->stats().free_cells + mcl_->stats().occupied_cells;
   }
 
-  std::string status_json() const override {
+  io::Json status_json() const override {
     const LocalizerStats& st = mcl_->stats();
-    auto u = [](std::uint64_t v) { return std::to_string(v); };
-    char spread[32];
-    std::snprintf(spread, sizeof spread, "%.4f", mcl_->spread_m());
-    return "\"particles\": " + u(mcl_->particle_count()) + ", \"filter_updates\": " + u(st.filter_updates) +
-           ", \"converged_at_scan\": " + std::to_string(converged_at_) + ", \"spread_m\": " + spread +
-           ", \"random_particles\": " + u(st.random_particles) + ", \"kld_capped\": " + u(st.kld_capped) +
-           ", \"arena_bytes\": " + u(arena_bytes_) + ", \"unrecorded_scans\": " + u(unrecorded_);
+    return {{"particles", mcl_->particle_count()},
+            {"filter_updates", st.filter_updates},
+            {"converged_at_scan", converged_at_},
+            {"spread_m", io::json_fixed(mcl_->spread_m(), 4)},
+            {"random_particles", st.random_particles},
+            {"kld_capped", st.kld_capped},
+            {"arena_bytes", arena_bytes_},
+            {"unrecorded_scans", unrecorded_}};
   }
 
   std::uint64_t unrecorded_scans() const override { return unrecorded_; }

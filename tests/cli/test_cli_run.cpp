@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "run_program.h"
@@ -471,14 +473,23 @@ TEST(CliRun, localize_names_a_bad_start_and_a_missing_map) {
   STRCMP_CONTAINS("none.yaml", r.out.c_str());
 }
 
-// stats.json stays JSON whatever the log's name: quotes and backslashes are escaped.
-TEST(CliRun, a_log_path_with_quotes_and_backslashes_gives_valid_json) {
+// stats.json stays JSON whatever the log's name: read back by a JSON parser, its "log" is
+// the path as given, quotes, backslashes and UTF-8 included, and its counts and timings
+// are numbers.
+TEST(CliRun, a_log_path_with_quotes_and_backslashes_reads_back_from_stats_json) {
   std::string text;
   for (int i = 0; i < 10; ++i) text += scan(0.05 * i, 100.0 + 0.1 * i);
-  const std::string log = put("we\"ird\\name.clf", text);
+  const std::string log = put("we\"ird\\na\xc3\xafve.clf", text);
   for (const char* mode : {"sdp", "dpslam"}) {
     Run r = run_cli("run '" + log + "' --mode " + mode + " --quiet --out " + dir + "/out");
     LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
-    STRCMP_CONTAINS("/we\\\"ird\\\\name.clf\",\n", text_of(dir + "/out/stats.json").c_str());
+    const std::string stats_text = text_of(dir + "/out/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(stats_text, nullptr, false);
+    CHECK_FALSE_TEXT(stats.is_discarded(), stats_text.c_str());
+    STRCMP_EQUAL(log.c_str(), stats["log"].get<std::string>().c_str());
+    STRCMP_EQUAL(mode, stats["mode"].get<std::string>().c_str());
+    LONGS_EQUAL(10, stats["scans"].get<int>());
+    CHECK_TRUE(stats["pools"]["ancestry_nodes"]["peak"].is_number_unsigned());
+    CHECK_TRUE(stats["timing"]["cpu_time_s"].is_number());
   }
 }

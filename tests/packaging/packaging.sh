@@ -59,13 +59,16 @@ sysroot)
   t=$(triplet_of "$arch")
   # Plain multiarch first (apt-get install libpng-dev:ARCH ...): then no folder is needed
   # and cmake/SdpslamTargetSysroot.cmake, finding none, leaves the search paths alone.
-  if [ -e "/usr/lib/$t/libpng16.so" ] && [ -e "/usr/lib/$t/libz.so" ] && [ -e "/usr/lib/$t/libinih.so" ]; then
+  # (libyaml-cpp-dev is not Multi-Arch: same, so beside the build machine's own it comes
+  # from the folder.)
+  if [ -e "/usr/lib/$t/libpng16.so" ] && [ -e "/usr/lib/$t/libz.so" ] && [ -e "/usr/lib/$t/libinih.so" ] \
+     && [ -e "/usr/lib/$t/libyaml-cpp.so" ]; then
     rm -rf "$sysroot"
-    say "the $arch libpng, zlib and inih are installed through multiarch: no sysroot needed"
+    say "the $arch libpng, zlib, inih and yaml-cpp are installed through multiarch: no sysroot needed"
     exit 0
   fi
   "$src/cmake/fetch-target-sysroot.sh" "$arch" "$sysroot" \
-    || skip "cannot get the $arch libpng/zlib/inih: not installed through multiarch, and apt-get download failed"
+    || skip "cannot get the $arch libpng/zlib/inih/yaml-cpp: not installed through multiarch, and apt-get download failed"
   ;;
 
 build)
@@ -175,6 +178,7 @@ contents)
         libpng16.so.*) pkg=libpng16-16 ;;
         libz.so.*) pkg=zlib1g ;;
         libinih.so.*) pkg=libinih1 ;;
+        libyaml-cpp.so.0.7) pkg=libyaml-cpp0.7 ;;
         *) bad "$(basename "$bin") needs $so, which this test cannot map to a package"; continue ;;
       esac
       printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/ .*//' | grep -qx "$pkg" \

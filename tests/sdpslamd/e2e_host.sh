@@ -98,10 +98,11 @@ grep -o '"input_log": {[^}]*}' "$work/daemon/status.json"
 sh "$(dirname "$0")/check_recording.sh" "$sdpslam" "$work/daemon" "$work/daemon/status.json" "$work/offline.ini" \
   "$mode" 5 "$work/recorded" host || exit 1
 if [ "$mode" = sdp ]; then
-  segs=$(sed -n 's/^  "segments": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
+  # status.json holds them in its "engine" object, stats.json at the top.
+  segs=$(sed -n 's/^ *"segments": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
   grep -q "\"segments\": $segs," "$work/recorded/stats.json" || { echo "FAIL: segment counts differ"; exit 1; }
   [ "${segs:-0}" -ge 2 ] || { echo "FAIL: only ${segs:-0} segments: the test no longer exercises the top level"; exit 1; }
-  perm=$(sed -n 's/^  "levels_made_permanent": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
+  perm=$(sed -n 's/^ *"levels_made_permanent": \([0-9]*\),$/\1/p' "$work/daemon/status.json")
   [ "${perm:-0}" -ge 1 ] || { echo "FAIL: no level became permanent: the test no longer exercises that path"; exit 1; }
   echo "segments: $segs, levels made permanent: $perm (sdpslamd and sdpslam run alike)"
 fi

@@ -12,6 +12,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/slam/run_sdp.h"
 #include "shared_data.h"
+#include "yaml_statics.h"  // localize mode reads a map YAML
 
 using sdpslam::daemon::DaemonConfig;
 using sdpslam::daemon::load_daemon_config;

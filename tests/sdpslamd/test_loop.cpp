@@ -7,13 +7,17 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "sdpslam/daemon/daemon.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "shared_data.h"
+#include "yaml_statics.h"  // localize mode reads a map YAML
 
 using namespace sdpslam;
 using namespace sdpslam::daemon;
@@ -105,7 +109,7 @@ class FakeEngine final : public SlamEngine {
     *image = map;
     return static_cast<std::uint32_t>(map.occupancy.size());
   }
-  std::string status_json() const override { return "\"fake\": true"; }
+  sdpslam::io::Json status_json() const override { return {{"fake", true}}; }
   std::uint64_t unrecorded_scans() const override { return 0U; }
   std::vector<OdometrySample> got;
   io::OccupancyImage map;  // what the engine "mapped" (empty by default)
@@ -332,6 +336,14 @@ TEST(SdpslamdLoop, finish_places_what_it_can_and_writes_outputs_atomically) {
   LONGS_EQUAL(1, r.d->counters().scans_skipped_no_odometry);
   CHECK_TRUE(file_exists(r.config.output_directory + "/status.json"));
   LONGS_EQUAL(0, temp_files_in(r.config.output_directory));
+  // status.json is JSON, with the engine's members in its "engine" object.
+  std::ifstream in(r.config.output_directory + "/status.json");
+  const nlohmann::json status = nlohmann::json::parse(in, nullptr, false);
+  CHECK_FALSE(status.is_discarded());
+  STRCMP_EQUAL("sdpslamd", status["program"].get<std::string>().c_str());
+  CHECK_TRUE(status["engine"]["fake"].get<bool>());
+  LONGS_EQUAL(1, status["scans"]["skipped_no_odometry"].get<int>());
+  CHECK_TRUE(status["cpu"]["user_s"].is_number());
 }
 
 TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {

@@ -32,7 +32,6 @@
 #include <vector>
 
 #include "cli_common.h"
-#include "sdpslam/io/json_text.h"
 #include "sdpslam/eval/ate.h"
 #include "sdpslam/eval/log_scans.h"
 #include "sdpslam/eval/loops.h"
@@ -41,7 +40,9 @@
 #include "sdpslam/eval/rpe.h"
 #include "sdpslam/eval/stamp_match.h"
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/map_read.h"
 #include "sdpslam/io/trajectory_io.h"
 
 namespace sdpslam::cli {
@@ -62,9 +63,8 @@ struct EvaluateArgs {
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
 };
 
-std::string json_stats(const eval::ErrorStats& s) {
-  return "{\"mean\": " + io::json_number(s.mean) + ", \"std\": " + io::json_number(s.std_dev) +
-         ", \"max\": " + io::json_number(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
+io::Json json_stats(const eval::ErrorStats& s) {
+  return {{"mean", s.mean}, {"std", s.std_dev}, {"max", s.max}, {"count", s.count}};
 }
 
 // ---- inputs ------------------------------------------------------------------------------
@@ -103,7 +103,7 @@ int read_trajectory_file(const std::string& path, std::vector<io::StampedPose>* 
 
 // ---- the evaluations --------------------------------------------------------------------
 
-int run_relations(const EvaluateArgs& a, std::string* json) {
+int run_relations(const EvaluateArgs& a, io::Json* json) {
   std::vector<eval::Relation> relations;
   std::string error;
   if (!eval::read_relations(a.relations_path, &relations, &error)) {
@@ -163,19 +163,20 @@ int run_relations(const EvaluateArgs& a, std::string* json) {
   row("rotation [deg]", res.rotation_deg);
   row("rotation^2 [deg^2]", res.rotation_deg2);
 
-  *json += "\"relations\": {\"file\": " + io::json_quote(a.relations_path) + ", \"log\": " + io::json_quote(a.log_path) +
-           ", \"trajectory\": " + (a.odometry ? std::string("\"odometry\"") : io::json_quote(a.trajectory_path)) +
-           ", \"relation_count\": " + std::to_string(res.relation_count) +
-           ", \"used_count\": " + std::to_string(res.used_count) +
-           ", \"exact_match_count\": " + std::to_string(res.exact_match_count) +
-           ", \"unmatched_count\": " + std::to_string(res.unmatched_count) +
-           ", \"scan_count\": " + std::to_string(fill.scan_count) +
-           ", \"filled_scan_count\": " + std::to_string(fill.filled_count) +
-           ", \"stamp_tolerance_us\": " + std::to_string(a.tolerance_us) +
-           ", \"translation_m\": " + json_stats(res.translation_m) +
-           ", \"translation_m2\": " + json_stats(res.translation_m2) +
-           ", \"rotation_deg\": " + json_stats(res.rotation_deg) +
-           ", \"rotation_deg2\": " + json_stats(res.rotation_deg2) + "}";
+  (*json)["relations"] = {{"file", a.relations_path},
+                          {"log", a.log_path},
+                          {"trajectory", a.odometry ? std::string("odometry") : a.trajectory_path},
+                          {"relation_count", res.relation_count},
+                          {"used_count", res.used_count},
+                          {"exact_match_count", res.exact_match_count},
+                          {"unmatched_count", res.unmatched_count},
+                          {"scan_count", fill.scan_count},
+                          {"filled_scan_count", fill.filled_count},
+                          {"stamp_tolerance_us", a.tolerance_us},
+                          {"translation_m", json_stats(res.translation_m)},
+                          {"translation_m2", json_stats(res.translation_m2)},
+                          {"rotation_deg", json_stats(res.rotation_deg)},
+                          {"rotation_deg2", json_stats(res.rotation_deg2)}};
   if (res.used_count == 0) {
     std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
                  a.log_path.c_str());
@@ -184,7 +185,7 @@ int run_relations(const EvaluateArgs& a, std::string* json) {
   return kExitOk;
 }
 
-int run_ate(const EvaluateArgs& a, std::string* json) {
+int run_ate(const EvaluateArgs& a, io::Json* json) {
   std::vector<io::StampedPose> estimate;
   std::vector<io::StampedPose> truth;
   if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
@@ -206,17 +207,18 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
               r.alignment.heading_rad * kRadToDeg);
   std::printf("  position    rmse %.6f m, mean %.6f m, max %.6f m\n", r.rmse_m, r.mean_m, r.max_m);
   std::printf("  heading     rmse %.6f deg\n", r.heading_rmse_rad * kRadToDeg);
-  *json += "\"ate\": {\"trajectory\": " + io::json_quote(a.trajectory_path) +
-           ", \"ground_truth\": " + io::json_quote(a.ground_truth_path) +
-           ", \"estimate_count\": " + std::to_string(r.estimate_count) +
-           ", \"ground_truth_count\": " + std::to_string(r.ground_truth_count) +
-           ", \"matched_count\": " + std::to_string(r.matched_count) +
-           ", \"unmatched_estimate_count\": " + std::to_string(r.unmatched_estimate_count) +
-           ", \"rmse_m\": " + io::json_number(r.rmse_m) + ", \"mean_m\": " + io::json_number(r.mean_m) +
-           ", \"max_m\": " + io::json_number(r.max_m) +
-           ", \"heading_rmse_deg\": " + io::json_number(r.heading_rmse_rad * kRadToDeg) +
-           ", \"alignment\": {\"x_m\": " + io::json_number(r.alignment.x_m) + ", \"y_m\": " + io::json_number(r.alignment.y_m) +
-           ", \"heading_rad\": " + io::json_number(r.alignment.heading_rad) + "}}";
+  io::Json& ate = (*json)["ate"];
+  ate = {{"trajectory", a.trajectory_path},
+         {"ground_truth", a.ground_truth_path},
+         {"estimate_count", r.estimate_count},
+         {"ground_truth_count", r.ground_truth_count},
+         {"matched_count", r.matched_count},
+         {"unmatched_estimate_count", r.unmatched_estimate_count},
+         {"rmse_m", r.rmse_m},
+         {"mean_m", r.mean_m},
+         {"max_m", r.max_m},
+         {"heading_rmse_deg", r.heading_rmse_rad * kRadToDeg},
+         {"alignment", {{"x_m", r.alignment.x_m}, {"y_m", r.alignment.y_m}, {"heading_rad", r.alignment.heading_rad}}}};
   if (!(a.rpe_m > 0.0)) return kExitOk;
   eval::RpeResult q;
   if (!eval::compute_rpe(estimate, truth, a.tolerance_us, a.rpe_m, &q)) {
@@ -227,21 +229,21 @@ int run_ate(const EvaluateArgs& a, std::string* json) {
               "along-track scale %+.3f %%\n",
               q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
               100.0 * q.scale_error);
-  *json += ", \"rpe\": {\"distance_m\": " + io::json_number(q.distance_m) +
-           ", \"stretch_count\": " + std::to_string(q.stretch_count) + ", \"mean_m\": " + io::json_number(q.mean_m) +
-           ", \"rmse_m\": " + io::json_number(q.rmse_m) + ", \"max_m\": " + io::json_number(q.max_m) +
-           ", \"heading_mean_deg\": " + io::json_number(q.heading_mean_rad * kRadToDeg) +
-           ", \"scale_error\": " + io::json_number(q.scale_error) + "}";
+  ate["rpe"] = {{"distance_m", q.distance_m},
+                {"stretch_count", q.stretch_count},
+                {"mean_m", q.mean_m},
+                {"rmse_m", q.rmse_m},
+                {"max_m", q.max_m},
+                {"heading_mean_deg", q.heading_mean_rad * kRadToDeg},
+                {"scale_error", q.scale_error}};
   return kExitOk;
 }
 
-std::string json_bins(const eval::LoopBins& b) {
-  return "{\"count\": " + std::to_string(b.count) + ", \"right\": " + std::to_string(b.right) +
-         ", \"between\": " + std::to_string(b.between) + ", \"wrong\": " + std::to_string(b.wrong) +
-         ", \"max_m\": " + io::json_number(b.max_m) + "}";
+io::Json json_bins(const eval::LoopBins& b) {
+  return {{"count", b.count}, {"right", b.right}, {"between", b.between}, {"wrong", b.wrong}, {"max_m", b.max_m}};
 }
 
-int run_loops(const EvaluateArgs& a, std::string* json) {
+int run_loops(const EvaluateArgs& a, io::Json* json) {
   std::vector<eval::LoopLine> lines;
   std::string error;
   if (!eval::read_loops(a.loops_path, &lines, &error)) {
@@ -262,13 +264,16 @@ int run_loops(const EvaluateArgs& a, std::string* json) {
   row("search", r.search);
   row("icp", r.icp);
   row("used", r.used);
-  *json += "\"loops\": {\"file\": " + io::json_quote(a.loops_path) + ", \"count\": " + std::to_string(r.count) +
-           ", \"unmatched\": " + std::to_string(r.unmatched) + ", \"search\": " + json_bins(r.search) +
-           ", \"icp\": " + json_bins(r.icp) + ", \"used\": " + json_bins(r.used) + "}";
+  (*json)["loops"] = {{"file", a.loops_path},
+                      {"count", r.count},
+                      {"unmatched", r.unmatched},
+                      {"search", json_bins(r.search)},
+                      {"icp", json_bins(r.icp)},
+                      {"used", json_bins(r.used)}};
   return kExitOk;
 }
 
-int run_map_agreement(const EvaluateArgs& a, std::string* json) {
+int run_map_agreement(const EvaluateArgs& a, io::Json* json) {
   std::vector<io::StampedPose> estimate;
   if (const int rc = read_trajectory_file(a.trajectory_path, &estimate); rc != kExitOk) return rc;
   // Logs are not always in time order (intel.clf), and trajectories follow the log.
@@ -276,7 +281,7 @@ int run_map_agreement(const EvaluateArgs& a, std::string* json) {
   io::OccupancyImage map;
   io::MapWriteOptions thresholds;
   std::string error;
-  if (!io::read_map_pgm_yaml(a.map_path, &map, &thresholds, &error)) {
+  if (!io::read_map_yaml(a.map_path, &map, &thresholds, &error)) {
     std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
     return kExitBadInput;
   }
@@ -289,10 +294,13 @@ int run_map_agreement(const EvaluateArgs& a, std::string* json) {
   std::printf("  map         %s: %u x %u cells of %.3f m\n", a.map_path.c_str(), map.width, map.height, map.resolution_m);
   std::printf("  scans       %zu of %zu cast from %s\n", r.scans_cast, r.scan_count, a.trajectory_path.c_str());
   std::printf("  on walls    %zu of %zu returns = %.4f\n", r.on_wall_count, r.return_count, r.share());
-  *json += "\"map_agreement\": {\"map\": " + io::json_quote(a.map_path) + ", \"trajectory\": " + io::json_quote(a.trajectory_path) +
-           ", \"scan_count\": " + std::to_string(r.scan_count) + ", \"scans_cast\": " + std::to_string(r.scans_cast) +
-           ", \"return_count\": " + std::to_string(r.return_count) +
-           ", \"on_wall_count\": " + std::to_string(r.on_wall_count) + ", \"share\": " + io::json_number(r.share()) + "}";
+  (*json)["map_agreement"] = {{"map", a.map_path},
+                              {"trajectory", a.trajectory_path},
+                              {"scan_count", r.scan_count},
+                              {"scans_cast", r.scans_cast},
+                              {"return_count", r.return_count},
+                              {"on_wall_count", r.on_wall_count},
+                              {"share", r.share()}};
   if (r.scans_cast == 0U) {
     std::fprintf(stderr, "sdpslam evaluate: no scan of %s has a pose in %s\n", a.log_path.c_str(),
                  a.trajectory_path.c_str());
@@ -336,35 +344,25 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --stamp-tolerance-us must not be negative\n");
     return kExitUsage;
   }
-  std::string json = "{";
+  io::Json json = io::Json::object();
   if (want_relations) {
     if (const int rc = run_relations(a, &json); rc != kExitOk) return rc;
   }
   if (want_ate && !a.trajectory_path.empty()) {
-    if (want_relations) {
-      json += ", ";
-      std::printf("\n");
-    }
+    if (!json.empty()) std::printf("\n");
     if (const int rc = run_ate(a, &json); rc != kExitOk) return rc;
   }
   if (want_loops) {
-    if (json.size() > 1U) {
-      json += ", ";
-      std::printf("\n");
-    }
+    if (!json.empty()) std::printf("\n");
     if (const int rc = run_loops(a, &json); rc != kExitOk) return rc;
   }
   if (want_map) {
-    if (json.size() > 1U) {
-      json += ", ";
-      std::printf("\n");
-    }
+    if (!json.empty()) std::printf("\n");
     if (const int rc = run_map_agreement(a, &json); rc != kExitOk) return rc;
   }
-  json += "}\n";
   if (!a.json_path.empty()) {
     std::string error;
-    if (!io::write_file_atomic(a.json_path, json, &error)) {
+    if (!io::write_file_atomic(a.json_path, io::json_text(json), &error)) {
       std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
       return kExitIo;
     }

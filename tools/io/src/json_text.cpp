@@ -1,37 +1,67 @@
 #include "sdpslam/io/json_text.h"
 
 #include <cmath>
-#include <cstdio>
 
 namespace sdpslam::io {
+namespace {
 
-std::string json_quote(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20U) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + "\"";
+std::string scalar_text(const Json& value) {
+  return value.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
-std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", value);
-  return buf;
+bool is_flat(const Json& container) {
+  for (const Json& member : container) {
+    if (member.is_structured() && !member.empty()) return false;
+  }
+  return true;
+}
+
+void append(const Json& value, int indent, std::string* out) {
+  if (!value.is_structured() || value.empty()) {
+    *out += scalar_text(value);
+    return;
+  }
+  const bool object = value.is_object();
+  const bool flat = is_flat(value);
+  const std::string inner(static_cast<std::size_t>(indent) + 2U, ' ');
+  *out += object ? '{' : '[';
+  bool first = true;
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (!first) *out += ',';
+    first = false;
+    if (flat) {
+      if (it != value.begin()) *out += ' ';
+    } else {
+      *out += '\n';
+      *out += inner;
+    }
+    if (object) {
+      *out += scalar_text(Json(it.key()));
+      *out += ": ";
+    }
+    append(it.value(), indent + 2, out);
+  }
+  if (!flat) {
+    *out += '\n';
+    out->append(static_cast<std::size_t>(indent), ' ');
+  }
+  *out += object ? '}' : ']';
+}
+
+}  // namespace
+
+std::string json_text(const Json& doc) {
+  std::string out;
+  append(doc, 0, &out);
+  out += '\n';
+  return out;
+}
+
+double json_fixed(double value, int decimals) {
+  if (!std::isfinite(value)) return value;
+  const double scale = std::pow(10.0, decimals < 0 ? 0 : decimals > 9 ? 9 : decimals);
+  const double scaled = value * scale;
+  return std::isfinite(scaled) ? std::round(scaled) / scale : value;
 }
 
 }  // namespace sdpslam::io

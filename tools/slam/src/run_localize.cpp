@@ -11,19 +11,21 @@
 
 #include "run_common.h"
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/map_read.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::slam {
 namespace {
 
-using detail::fmt;
 using detail::percentile;
 using detail::thread_cpu_ms;
 
-// The map's classes as map_server reads them (io::read_map_pgm_yaml: occupancy above
-// occupied_thresh, below free_thresh, else unknown = -1).
+// The map's classes as map_server reads them (io::read_map_yaml: occupancy above
+// occupied_thresh, below free_thresh, else unknown: -1, or between the thresholds in
+// mode scale).
 std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::MapWriteOptions& t) {
   std::vector<std::uint8_t> cells(img.occupancy.size(), LocalizerMap::kUnknown);
   for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -39,7 +41,7 @@ std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::Map
 
 bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error) {
   io::MapWriteOptions thresholds;
-  if (!io::read_map_pgm_yaml(map_yaml, &out->image, &thresholds, error)) return false;
+  if (!io::read_map_yaml(map_yaml, &out->image, &thresholds, error)) return false;
   out->cells = map_cells(out->image, thresholds);
   out->map = LocalizerMap{};
   out->map.width = out->image.width;
@@ -150,31 +152,39 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
   const double log_s = static_cast<double>(trajectory.back().stamp_us - trajectory.front().stamp_us) * 1e-6;
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
-  std::string js = "{\n";
-  js += "  \"mode\": \"localize\",\n  \"start\": \"" + std::string(options.have_start ? "given" : "global") + "\",\n";
-  js += "  \"seed\": " + u(options.seed) + ",\n  \"skipped_scans\": " + u(skipped) + ",\n";
-  js += "  \"scans\": " + u(trajectory.size()) + ",\n  \"filter_updates\": " + u(st.filter_updates) + ",\n";
-  js += "  \"converged_at_scan\": " + std::to_string(converged_at) + ",\n";
-  js += "  \"converged_spread_m\": " + fmt("%.3f", kConvergedSpreadM) + ",\n";
-  js += "  \"final_spread_m\": " + fmt("%.6f", mcl->spread_m()) + ",\n";
-  js += "  \"final_particles\": " + u(mcl->particle_count()) + ",\n";
-  js += "  \"random_particles\": " + u(st.random_particles) + ",\n  \"kld_capped\": " + u(st.kld_capped) +
-        ",\n  \"degenerate_weights\": " + u(st.degenerate_weights) + ",\n  \"beams_weighed\": " +
-        u(st.beams_weighed) + ",\n";
-  js += "  \"map\": {\"width\": " + u(map.width) + ", \"height\": " + u(map.height) +
-        ", \"resolution_m\": " + fmt("%.6f", map.resolution_m) + ", \"free_cells\": " + u(st.free_cells) +
-        ", \"occupied_cells\": " + u(st.occupied_cells) + "},\n";
-  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"arena_used_bytes\": " + u(arena.used_bytes()) +
-        ", \"min_particles\": " + u(options.localizer.min_particles) + ", \"max_particles\": " +
-        u(options.localizer.max_particles) + "},\n";
-  js += "  \"timing\": {\"cpu_ms_per_scan_mean\": " + fmt("%.4f", cpu_ms / static_cast<double>(trajectory.size())) +
-        ", \"cpu_ms_per_update_p50\": " + fmt("%.4f", percentile(update_ms, 0.5)) +
-        ", \"cpu_ms_per_update_p99\": " + fmt("%.4f", percentile(update_ms, 0.99)) +
-        ", \"cpu_ms_per_update_max\": " + fmt("%.4f", percentile(update_ms, 1.0)) + ", \"log_s\": " +
-        fmt("%.3f", log_s) + ", \"localizer_cpu_s\": " + fmt("%.3f", cpu_ms * 1e-3) +
-        ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) + "}\n}\n";
-  if (!io::write_file_atomic(outputs.path("stats.json"), js, error)) return LocalizeStatus::kIoError;
+  auto fixed = [](double v, int decimals) { return io::json_fixed(v, decimals); };
+  io::Json js;
+  js["mode"] = "localize";
+  js["start"] = options.have_start ? "given" : "global";
+  js["seed"] = options.seed;
+  js["skipped_scans"] = skipped;
+  js["scans"] = trajectory.size();
+  js["filter_updates"] = st.filter_updates;
+  js["converged_at_scan"] = converged_at;
+  js["converged_spread_m"] = fixed(kConvergedSpreadM, 3);
+  js["final_spread_m"] = fixed(mcl->spread_m(), 6);
+  js["final_particles"] = mcl->particle_count();
+  js["random_particles"] = st.random_particles;
+  js["kld_capped"] = st.kld_capped;
+  js["degenerate_weights"] = st.degenerate_weights;
+  js["beams_weighed"] = st.beams_weighed;
+  js["map"] = {{"width", map.width},
+               {"height", map.height},
+               {"resolution_m", fixed(map.resolution_m, 6)},
+               {"free_cells", st.free_cells},
+               {"occupied_cells", st.occupied_cells}};
+  js["memory"] = {{"arena_bytes", arena_bytes},
+                  {"arena_used_bytes", arena.used_bytes()},
+                  {"min_particles", options.localizer.min_particles},
+                  {"max_particles", options.localizer.max_particles}};
+  js["timing"] = {{"cpu_ms_per_scan_mean", fixed(cpu_ms / static_cast<double>(trajectory.size()), 4)},
+                  {"cpu_ms_per_update_p50", fixed(percentile(update_ms, 0.5), 4)},
+                  {"cpu_ms_per_update_p99", fixed(percentile(update_ms, 0.99), 4)},
+                  {"cpu_ms_per_update_max", fixed(percentile(update_ms, 1.0), 4)},
+                  {"log_s", fixed(log_s, 3)},
+                  {"localizer_cpu_s", fixed(cpu_ms * 1e-3, 3)},
+                  {"peak_rss_kib", static_cast<std::uint64_t>(ru.ru_maxrss)}};
+  if (!io::write_file_atomic(outputs.path("stats.json"), io::json_text(js), error)) return LocalizeStatus::kIoError;
   if (!outputs.commit(error)) return LocalizeStatus::kIoError;
 
   if (summary != nullptr) {

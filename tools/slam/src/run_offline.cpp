@@ -7,6 +7,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "sdpslam/core/bottom/dpslam_filter.h"
@@ -27,7 +28,6 @@ class CollectSink final : public PoseSink {
   std::vector<io::StampedPose> poses;
 };
 
-using detail::fmt;
 using detail::percentile;
 using detail::rusage_cpu_s;
 using detail::thread_cpu_ms;
@@ -116,40 +116,47 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
-  std::string js = "{\n";
-  js += "  \"log\": " + io::json_quote(log_path) + ",\n";
-  js += "  \"mode\": \"dpslam\",\n  \"particles\": " + u(fo.particle_count) + ",\n  \"seed\": " + u(options.seed) + ",\n";
-  js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(st.processed) + ",\n";
-  js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
-  js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
-  js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
-  js += "  \"odometry_jumps_removed\": " + u(reader.odometry_jumps_removed()) + ",\n";
-  js += "  \"scans_stamped_backwards\": " + u(reader.scans_stamped_backwards()) + ",\n";
-  js += "  \"resamplings\": " + u(st.resamplings) + ",\n";
-  js += "  \"proposal\": {\"matched\": " + u(st.proposal_matched) + ", \"fallback_few_beams\": " +
-        u(st.proposal_fallback_few_beams) + ", \"fallback_empty_map\": " + u(st.proposal_fallback_empty_map) +
-        ", \"fallback_low_score\": " + u(st.proposal_fallback_low_score) + ", \"evaluations\": " +
-        u(st.proposal_evaluations) + "},\n";
-  js += "  \"pools\": {\n";
-  js += filter_pools_json(*filter);
-  js += "    \"map_updates_dropped\": " + u(st.map_updates_dropped) + ",\n";
-  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
-  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
-  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"state_bytes_peak\": " + u(state_bytes) +
-        ", \"best_map_known_cells\": " + u(known_cells) + ", \"naive_copy_bytes\": " + u(naive_bytes) + "},\n";
-  js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
-        fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
-        ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"processed_ms_p50\": " +
-        fmt("%.3f", percentile(processed_ms, 0.5)) + ", \"processed_ms_p99\": " +
-        fmt("%.3f", percentile(processed_ms, 0.99)) + ", \"processed_ms_max\": " +
-        fmt("%.3f", percentile(processed_ms, 1.0)) + ", \"scan_cpu_ms_p50\": " +
-        fmt("%.3f", percentile(scan_cpu_ms, 0.5)) + ", \"scan_cpu_ms_p99\": " +
-        fmt("%.3f", percentile(scan_cpu_ms, 0.99)) + ", \"scan_cpu_ms_max\": " +
-        fmt("%.3f", percentile(scan_cpu_ms, 1.0)) + ", \"cpu_time_s\": " +
-        fmt("%.3f", rusage_cpu_s(ru)) + ", \"peak_rss_kib\": " + u(static_cast<std::uint64_t>(ru.ru_maxrss)) +
-        "}\n}\n";
-  if (!io::write_file_atomic(outputs.path("stats.json"), js, error)) return RunStatus::kIoError;
+  auto ms = [](double v) { return io::json_fixed(v, 3); };
+  io::Json js;
+  js["log"] = log_path;
+  js["mode"] = "dpslam";
+  js["particles"] = fo.particle_count;
+  js["seed"] = options.seed;
+  js["scans"] = scans.size();
+  js["processed_scans"] = st.processed;
+  js["scans_without_odometry"] = pairing.scans_without_odom();
+  js["log_errors"] = reader.error_count();
+  js["odometry_reversals_repaired"] = reader.odometry_reversals_repaired();
+  js["odometry_jumps_removed"] = reader.odometry_jumps_removed();
+  js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
+  js["resamplings"] = st.resamplings;
+  js["proposal"] = {{"matched", st.proposal_matched},
+                    {"fallback_few_beams", st.proposal_fallback_few_beams},
+                    {"fallback_empty_map", st.proposal_fallback_empty_map},
+                    {"fallback_low_score", st.proposal_fallback_low_score},
+                    {"evaluations", st.proposal_evaluations}};
+  io::Json pools = filter_pools_json(*filter);
+  pools["map_updates_dropped"] = st.map_updates_dropped;
+  pools["out_of_map_updates"] = map.out_of_bounds_count();
+  pools["trajectory_gaps_filled_from_odometry"] = path_gaps;
+  js["pools"] = std::move(pools);
+  js["memory"] = {{"arena_bytes", arena_bytes},
+                  {"state_bytes_peak", state_bytes},
+                  {"best_map_known_cells", known_cells},
+                  {"naive_copy_bytes", naive_bytes}};
+  js["timing"] = {{"wall_time_s", ms(wall_s)},
+                  {"scan_ms_p50", ms(percentile(scan_ms, 0.5))},
+                  {"scan_ms_p99", ms(percentile(scan_ms, 0.99))},
+                  {"scan_ms_max", ms(percentile(scan_ms, 1.0))},
+                  {"processed_ms_p50", ms(percentile(processed_ms, 0.5))},
+                  {"processed_ms_p99", ms(percentile(processed_ms, 0.99))},
+                  {"processed_ms_max", ms(percentile(processed_ms, 1.0))},
+                  {"scan_cpu_ms_p50", ms(percentile(scan_cpu_ms, 0.5))},
+                  {"scan_cpu_ms_p99", ms(percentile(scan_cpu_ms, 0.99))},
+                  {"scan_cpu_ms_max", ms(percentile(scan_cpu_ms, 1.0))},
+                  {"cpu_time_s", ms(rusage_cpu_s(ru))},
+                  {"peak_rss_kib", static_cast<std::uint64_t>(ru.ru_maxrss)}};
+  if (!io::write_file_atomic(outputs.path("stats.json"), io::json_text(js), error)) return RunStatus::kIoError;
   if (!outputs.commit(error)) return RunStatus::kIoError;
 
   if (summary != nullptr) {

@@ -100,7 +100,6 @@ class Rows final : public TopLevelListener {
   std::vector<Row> rows;
 };
 
-using detail::fmt;
 using detail::percentile;
 using detail::rusage_cpu_s;
 using detail::thread_cpu_ms;
@@ -398,38 +397,42 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
   const SdpOptions& so = options.sdp;
-  std::string js = "{\n";
-  js += "  \"log\": " + io::json_quote(log_path) + ",\n";
-  js += "  \"mode\": \"sdp\",\n  \"profile\": \"" + std::string(to_string(options.profile)) + "\",\n";
-  js += "  \"topology\": \"" + std::string(so.topology == TopologyMode::kSdp ? "sdp" : "segslam") +
-        "\",\n";
-  js += "  \"top_particles\": " + u(so.top_particles) + ",\n  \"bottom_particles\": " + u(fo.particle_count) +
-        ",\n  \"seed\": " + u(options.seed) + ",\n";
-  js += "  \"scans\": " + u(scans.size()) + ",\n  \"processed_scans\": " + u(bs.processed) + ",\n";
-  js += "  \"scans_without_odometry\": " + u(pairing.scans_without_odom()) + ",\n";
-  js += "  \"log_errors\": " + u(reader.error_count()) + ",\n";
-  js += "  \"odometry_reversals_repaired\": " + u(reader.odometry_reversals_repaired()) + ",\n";
-  js += "  \"odometry_jumps_removed\": " + u(reader.odometry_jumps_removed()) + ",\n";
-  js += "  \"scans_stamped_backwards\": " + u(reader.scans_stamped_backwards()) + ",\n";
-  js += sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells);
-  js += "  \"timing\": {\"wall_time_s\": " + fmt("%.3f", wall_s) + ", \"scan_ms_p50\": " +
-        fmt("%.3f", percentile(scan_ms, 0.5)) + ", \"scan_ms_p99\": " + fmt("%.3f", percentile(scan_ms, 0.99)) +
-        ", \"scan_ms_max\": " + fmt("%.3f", percentile(scan_ms, 1.0)) + ", \"segmentation_scan_ms_max\": " +
-        fmt("%.3f", percentile(segment_ms, 1.0)) + ", \"scan_cpu_ms_p50\": " + fmt("%.3f", percentile(scan_cpu_ms, 0.5)) +
-        ", \"scan_cpu_ms_p99\": " + fmt("%.3f", percentile(scan_cpu_ms, 0.99)) + ", \"scan_cpu_ms_max\": " +
-        fmt("%.3f", percentile(scan_cpu_ms, 1.0)) + ", \"cpu_time_s\": " +
-        fmt("%.3f", rusage_cpu_s(ru)) +
-        ", \"scan_cpu_ms_max_segmentation\": " + fmt("%.3f", cpu_max_by_kind[0]) +
-        ", \"scan_cpu_ms_max_evaluation\": " + fmt("%.3f", cpu_max_by_kind[1]) +
-        ", \"scan_cpu_ms_max_anchorage\": " + fmt("%.3f", cpu_max_by_kind[2]) +
-        ", \"scan_cpu_ms_max_bottom_only\": " + fmt("%.3f", cpu_max_by_kind[3]) +
-        ", \"scan_cpu_ms_max_bottom_processed\": " + fmt("%.3f", cpu_max_bottom_processed) +
-        ", \"scan_cpu_ms_max_bottom_idle\": " + fmt("%.3f", cpu_max_bottom_idle) +
-        ", \"scans_cpu_over_100ms\": " + u(scans_cpu_over_100ms) + ", \"peak_rss_kib\": " +
-        u(static_cast<std::uint64_t>(ru.ru_maxrss)) + "}\n}\n";
-  if (!io::write_file_atomic(outputs.path("stats.json"), js, error)) return SdpRunStatus::kIoError;
+  auto ms = [](double v) { return io::json_fixed(v, 3); };
+  io::Json js;
+  js["log"] = log_path;
+  js["mode"] = "sdp";
+  js["profile"] = to_string(options.profile);
+  js["topology"] = so.topology == TopologyMode::kSdp ? "sdp" : "segslam";
+  js["top_particles"] = so.top_particles;
+  js["bottom_particles"] = fo.particle_count;
+  js["seed"] = options.seed;
+  js["scans"] = scans.size();
+  js["processed_scans"] = bs.processed;
+  js["scans_without_odometry"] = pairing.scans_without_odom();
+  js["log_errors"] = reader.error_count();
+  js["odometry_reversals_repaired"] = reader.odometry_reversals_repaired();
+  js["odometry_jumps_removed"] = reader.odometry_jumps_removed();
+  js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
+  js.update(sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells));
+  js["timing"] = {{"wall_time_s", ms(wall_s)},
+                  {"scan_ms_p50", ms(percentile(scan_ms, 0.5))},
+                  {"scan_ms_p99", ms(percentile(scan_ms, 0.99))},
+                  {"scan_ms_max", ms(percentile(scan_ms, 1.0))},
+                  {"segmentation_scan_ms_max", ms(percentile(segment_ms, 1.0))},
+                  {"scan_cpu_ms_p50", ms(percentile(scan_cpu_ms, 0.5))},
+                  {"scan_cpu_ms_p99", ms(percentile(scan_cpu_ms, 0.99))},
+                  {"scan_cpu_ms_max", ms(percentile(scan_cpu_ms, 1.0))},
+                  {"cpu_time_s", ms(rusage_cpu_s(ru))},
+                  {"scan_cpu_ms_max_segmentation", ms(cpu_max_by_kind[0])},
+                  {"scan_cpu_ms_max_evaluation", ms(cpu_max_by_kind[1])},
+                  {"scan_cpu_ms_max_anchorage", ms(cpu_max_by_kind[2])},
+                  {"scan_cpu_ms_max_bottom_only", ms(cpu_max_by_kind[3])},
+                  {"scan_cpu_ms_max_bottom_processed", ms(cpu_max_bottom_processed)},
+                  {"scan_cpu_ms_max_bottom_idle", ms(cpu_max_bottom_idle)},
+                  {"scans_cpu_over_100ms", scans_cpu_over_100ms},
+                  {"peak_rss_kib", static_cast<std::uint64_t>(ru.ru_maxrss)}};
+  if (!io::write_file_atomic(outputs.path("stats.json"), io::json_text(js), error)) return SdpRunStatus::kIoError;
   if (!outputs.commit(error)) return SdpRunStatus::kIoError;
 
   if (summary != nullptr) {

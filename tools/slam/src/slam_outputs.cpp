@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace sdpslam::slam {
 
@@ -200,19 +201,21 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   return known_cells;
 }
 
-std::string filter_pools_json(const DpSlamFilter& filter) {
+io::Json filter_pools_json(const DpSlamFilter& filter) {
   const AncestryTree& tree = filter.tree();
   const DpMap& map = filter.map();
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
-  std::string js;
-  js += "    \"ancestry_nodes\": {\"capacity\": " + u(tree.capacity()) + ", \"peak\": " + u(tree.peak_used()) +
-        ", \"exhausted\": " + u(tree.node_oom_count()) + ", \"fallbacks\": " + u(filter.stats().node_fallback_count) + "},\n";
-  js += "    \"path_entries\": {\"capacity\": " + u(tree.path_entry_capacity()) + ", \"peak\": " +
-        u(tree.path_entries_peak()) + ", \"exhausted\": " + u(tree.path_oom_count()) + "},\n";
-  js += "    \"observations\": {\"capacity\": " + u(map.observation_capacity()) + ", \"peak\": " +
-        u(map.observations_peak()) + ", \"exhausted\": " + u(map.observation_oom_count()) + "},\n";
-  js += "    \"tiles\": {\"capacity\": " + u(map.tile_capacity()) + ", \"peak\": " + u(map.tiles_peak()) +
-        ", \"exhausted\": " + u(map.tile_oom_count()) + "},\n";
+  io::Json js;
+  js["ancestry_nodes"] = {{"capacity", tree.capacity()},
+                          {"peak", tree.peak_used()},
+                          {"exhausted", tree.node_oom_count()},
+                          {"fallbacks", filter.stats().node_fallback_count}};
+  js["path_entries"] = {{"capacity", tree.path_entry_capacity()},
+                        {"peak", tree.path_entries_peak()},
+                        {"exhausted", tree.path_oom_count()}};
+  js["observations"] = {{"capacity", map.observation_capacity()},
+                        {"peak", map.observations_peak()},
+                        {"exhausted", map.observation_oom_count()}};
+  js["tiles"] = {{"capacity", map.tile_capacity()}, {"peak", map.tiles_peak()}, {"exhausted", map.tile_oom_count()}};
   return js;
 }
 
@@ -241,68 +244,81 @@ std::string sdp_loops_tsv(const SdpSlam& slam) {
   return out;
 }
 
-std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
-                           std::uint64_t path_gaps, std::uint32_t known_cells) {
+io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
+                        std::uint64_t path_gaps, std::uint32_t known_cells) {
   const DpSlamFilter& bottom = slam.bottom();
   const DpMap& map = bottom.map();
   const DpSlamStats& bs = bottom.stats();
   const SdpStats& st = slam.stats();
   const SegmentGraph& g = slam.graph();
   const SdpOptions& so = slam.options();
-  auto u = [](std::uint64_t v) { return std::to_string(v); };
-  auto fmt = [](const char* f, double v) {
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return std::string(b);
-  };
-  std::string js;
-  js += "  \"segments\": " + u(st.segments) + ",\n  \"restart_refused\": " + u(st.restart_refused) + ",\n";
-  js += "  \"window_segmentations\": " + u(st.window_segmentations) + ",\n  \"pool_segmentations\": " +
-        u(st.pool_segmentations) + ",\n";
-  js += "  \"levels_made_permanent\": " + u(st.levels_made_permanent) + ",\n  \"levels_made_permanent_for_room\": " +
-        u(st.levels_made_permanent_for_room) + ",\n  \"submaps_released\": " +
-        u(st.submaps_released) + ",\n";
-  js += "  \"global_map_transfers\": {\"cells\": " + u(st.map_transfer_cells) + ", \"popped\": " +
-        u(st.map_transfers_popped) + ", \"by_rows\": " + u(st.map_transfers_by_rows) +
-        ", \"permanent_offset_m\": " + fmt("%.3f", st.permanent_map_offset_m) +
-        ", \"permanent_offset_max_m\": " + fmt("%.3f", st.permanent_map_offset_max_m) + "},\n";
-  js += "  \"icp_error\": {\"mean_m\": " + fmt("%.6f", st.error_mean_m()) + ", \"std_m\": " +
-        fmt("%.6f", st.error_std_m()) + ", \"samples\": " + u(st.error_samples) + ", \"rounds\": " + u(st.rounds) +
-        ", \"rounds_with_overlap\": " + u(st.rounds_with_overlap) + ", \"evaluations\": " + u(st.evaluations) +
-        ", \"icp_matches\": " + u(st.icp_matches) + ", \"icp_failures\": " + u(st.icp_failures) + "},\n";
-  js += "  \"top_work_deferred\": " + u(st.top_work_deferred) + ",\n";
-  js += "  \"bottom_proposal\": \"" +
-        std::string(bottom.options().proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry") + "\",\n";
-  js += "  \"loop_closure\": {\"enabled\": " + std::string(so.loop_closure ? "true" : "false") + ", \"records\": " +
-        u(st.loop_records) + ", \"refinements\": " + u(st.loop_refinements) + ", \"added\": " + u(st.loop_records_added) + ", \"dropped\": " +
-        u(st.loop_records_dropped) + ", \"used_last\": " + u(st.loop_constraints_used) + ", \"downweighted_last\": " +
-        u(st.loop_downweighted) + ", \"weak_direction\": " + u(st.loop_constraints_weak_direction) +
-        ", \"information_unmeasured\": " + u(st.loop_information_unmeasured) +
-        ", \"adjustments\": " + u(st.frame_adjustments) + ", \"graph_refused\": " +
-        u(st.frame_graph_refused) + ", \"search\": {\"window_m\": " + fmt("%.3f", so.loop_search_window_m) +
-        ", \"pairs\": " + u(st.loop_searches) + ", \"weak\": " + u(st.loop_search_weak) + ", \"ambiguous\": " +
-        u(st.loop_search_ambiguous) + ", \"failed\": " + u(st.loop_search_failed) + ", \"refuted\": " +
-        u(st.loop_search_refuted) + ", \"closed\": " + u(st.loop_search_closed) + ", \"far\": " +
-        u(st.loop_search_far) + ", \"held\": " + u(st.loop_search_held) + ", \"confirmed\": " +
-        u(st.loop_search_confirmed) + "}},\n";
-  js += "  \"pools\": {\n";
-  js += filter_pools_json(bottom);
-  js += "    \"pgs_levels\": {\"capacity\": " + u(so.max_levels) + ", \"peak\": " + u(g.peak_levels_used()) +
-        ", \"refused\": " + u(st.pgs_refused) + "},\n";
-  js += "    \"permanent_submaps\": {\"capacity\": " + u(so.max_permanent_submaps) + ", \"used\": " +
-        u(slam.permanent_submap_count()) + ", \"forgotten\": " + u(st.permanent_forgotten) + "},\n";
+  auto fixed = [](double v, int decimals) { return io::json_fixed(v, decimals); };
+  io::Json js;
+  js["segments"] = st.segments;
+  js["restart_refused"] = st.restart_refused;
+  js["window_segmentations"] = st.window_segmentations;
+  js["pool_segmentations"] = st.pool_segmentations;
+  js["levels_made_permanent"] = st.levels_made_permanent;
+  js["levels_made_permanent_for_room"] = st.levels_made_permanent_for_room;
+  js["submaps_released"] = st.submaps_released;
+  js["global_map_transfers"] = {{"cells", st.map_transfer_cells},
+                                {"popped", st.map_transfers_popped},
+                                {"by_rows", st.map_transfers_by_rows},
+                                {"permanent_offset_m", fixed(st.permanent_map_offset_m, 3)},
+                                {"permanent_offset_max_m", fixed(st.permanent_map_offset_max_m, 3)}};
+  js["icp_error"] = {{"mean_m", fixed(st.error_mean_m(), 6)},
+                     {"std_m", fixed(st.error_std_m(), 6)},
+                     {"samples", st.error_samples},
+                     {"rounds", st.rounds},
+                     {"rounds_with_overlap", st.rounds_with_overlap},
+                     {"evaluations", st.evaluations},
+                     {"icp_matches", st.icp_matches},
+                     {"icp_failures", st.icp_failures}};
+  js["top_work_deferred"] = st.top_work_deferred;
+  js["bottom_proposal"] = bottom.options().proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry";
+  js["loop_closure"] = {{"enabled", so.loop_closure},
+                        {"records", st.loop_records},
+                        {"refinements", st.loop_refinements},
+                        {"added", st.loop_records_added},
+                        {"dropped", st.loop_records_dropped},
+                        {"used_last", st.loop_constraints_used},
+                        {"downweighted_last", st.loop_downweighted},
+                        {"weak_direction", st.loop_constraints_weak_direction},
+                        {"information_unmeasured", st.loop_information_unmeasured},
+                        {"adjustments", st.frame_adjustments},
+                        {"graph_refused", st.frame_graph_refused},
+                        {"search",
+                         {{"window_m", fixed(so.loop_search_window_m, 3)},
+                          {"pairs", st.loop_searches},
+                          {"weak", st.loop_search_weak},
+                          {"ambiguous", st.loop_search_ambiguous},
+                          {"failed", st.loop_search_failed},
+                          {"refuted", st.loop_search_refuted},
+                          {"closed", st.loop_search_closed},
+                          {"far", st.loop_search_far},
+                          {"held", st.loop_search_held},
+                          {"confirmed", st.loop_search_confirmed}}}};
+  io::Json pools = filter_pools_json(bottom);
+  pools["pgs_levels"] = {{"capacity", so.max_levels}, {"peak", g.peak_levels_used()}, {"refused", st.pgs_refused}};
+  pools["permanent_submaps"] = {{"capacity", so.max_permanent_submaps},
+                                {"used", slam.permanent_submap_count()},
+                                {"forgotten", st.permanent_forgotten}};
   const PermanentMap& pmap = slam.permanent_map();
-  js += "    \"permanent_map_tiles\": {\"capacity\": " + u(pmap.tile_capacity()) + ", \"used\": " +
-        u(pmap.tiles_used()) + ", \"known_cells\": " + u(pmap.known_cells()) + ", \"exhausted\": " +
-        u(pmap.refused_no_tile()) + "},\n";
-  js += "    \"pose_ring\": {\"capacity\": " + u(slam.pose_ring_capacity()) + ", \"peak\": " + u(st.pose_ring_peak) +
-        ", \"dropped\": " + u(st.pose_ring_dropped) + "},\n";
-  js += "    \"map_updates_dropped\": " + u(bs.map_updates_dropped) + ",\n";
-  js += "    \"global_map_updates_dropped\": " + u(st.map_transfer_dropped) + ",\n";
-  js += "    \"out_of_map_updates\": " + u(map.out_of_bounds_count()) + ",\n";
-  js += "    \"trajectory_gaps_filled_from_odometry\": " + u(path_gaps) + "\n  },\n";
-  js += "  \"memory\": {\"arena_bytes\": " + u(arena_bytes) + ", \"arena_used_bytes\": " + u(arena_used_bytes) +
-        ", \"global_map_known_cells\": " + u(known_cells) + "},\n";
+  pools["permanent_map_tiles"] = {{"capacity", pmap.tile_capacity()},
+                                  {"used", pmap.tiles_used()},
+                                  {"known_cells", pmap.known_cells()},
+                                  {"exhausted", pmap.refused_no_tile()}};
+  pools["pose_ring"] = {{"capacity", slam.pose_ring_capacity()},
+                        {"peak", st.pose_ring_peak},
+                        {"dropped", st.pose_ring_dropped}};
+  pools["map_updates_dropped"] = bs.map_updates_dropped;
+  pools["global_map_updates_dropped"] = st.map_transfer_dropped;
+  pools["out_of_map_updates"] = map.out_of_bounds_count();
+  pools["trajectory_gaps_filled_from_odometry"] = path_gaps;
+  js["pools"] = std::move(pools);
+  js["memory"] = {{"arena_bytes", arena_bytes},
+                  {"arena_used_bytes", arena_used_bytes},
+                  {"global_map_known_cells", known_cells}};
   return js;
 }
 

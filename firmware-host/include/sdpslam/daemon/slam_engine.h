@@ -20,6 +20,7 @@
 
 #include "sdpslam/core/range_scan.h"
 #include "sdpslam/daemon/daemon_config.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 
@@ -39,8 +40,8 @@ class SlamEngine {
   virtual std::vector<io::StampedPose> trajectory() const = 0;
   // The current best map; returns its known cells (image width 0 when empty).
   virtual std::uint32_t map_image(io::OccupancyImage* image) const = 0;
-  // Engine counters as JSON members (`"key": value` pairs, comma separated, no braces).
-  virtual std::string status_json() const = 0;
+  // Engine counters: the members of status.json's "engine" object.
+  virtual io::Json status_json() const = 0;
   virtual std::uint64_t unrecorded_scans() const = 0;
   // The input has ended: complete deferred work so that the final outputs are those of
   // the offline runner at the end of its log (sdp: SdpSlam::finish(), the pending

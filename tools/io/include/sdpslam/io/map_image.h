@@ -2,7 +2,6 @@
 // Occupancy map outputs: PGM + YAML in the ROS map_server convention, and PNG (libpng),
 // optionally with a trajectory drawn on it. All writes are atomic.
 #include <cstdint>
-#include <istream>
 #include <string>
 #include <vector>
 
@@ -34,36 +33,7 @@ struct MapWriteOptions {
 bool write_map_pgm_yaml(const std::string& stem, const OccupancyImage& map, const MapWriteOptions& options,
                         std::string* error);
 
-// Reads a map written in the map_server convention: the YAML at `yaml_path` (image,
-// resolution, origin, negate, occupied_thresh, free_thresh; other keys ignored) and the
-// binary PGM (P5, maxval <= 255) it names, relative to the YAML's folder. A pixel's
-// occupancy p is (maxval - v) / maxval (v / maxval with negate); as map_server reads it,
-// p > occupied_thresh is occupied, p < free_thresh free, anything else unknown (-1). A
-// known cell's float keeps its class: occupancy > occupied_thresh or < free_thresh
-// compared in double, whatever the thresholds' digits. `thresholds`
-// (may be null) gets the YAML's. False, with "file[:line]: why" in `error`, on a missing
-// file or key, a bad value, a short image or a pixel above maxval.
-bool read_map_pgm_yaml(const std::string& yaml_path, OccupancyImage* map, MapWriteOptions* thresholds,
-                       std::string* error);
-
-// The two halves of read_map_pgm_yaml, without file access.
-// What the YAML says: the image as written (relative to the YAML's folder unless it starts
-// with '/'), the cell size, the origin, and negate / occupied_thresh / free_thresh.
-struct MapYaml {
-  std::string image;
-  double resolution_m = 0.0;
-  double origin_x_m = 0.0;
-  double origin_y_m = 0.0;
-  MapWriteOptions thresholds;
-};
-// Parses YAML text (`name` stands for the file in messages). False, with
-// "name[:line]: why", on a missing key or a bad value, as read_map_pgm_yaml.
-bool parse_map_yaml(std::istream& yaml, const std::string& name, MapYaml* out, std::string* error);
-// Decodes the bytes of a binary PGM with the geometry and thresholds of `yaml`. False,
-// with "name: why", on a bad header, a short image or a pixel above maxval; *map is then
-// untouched.
-bool decode_map_pgm(const std::string& pgm, const std::string& name, const MapYaml& yaml, OccupancyImage* map,
-                    std::string* error);
+// Reading maps back (this writer's, map_server's, nav2's): map_read.h.
 
 // Writes a grey PNG of the map; if `trajectory` is non-empty it is drawn in colour
 // (RGB PNG) on top, with the start and end marked.

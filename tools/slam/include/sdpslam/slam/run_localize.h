@@ -51,7 +51,7 @@ struct LocalizeSummary {
 enum class LocalizeStatus { kOk, kBadInput, kIoError, kInternal };
 
 // A saved map as the localizer takes it (`sdpslam localize`, sdpslamd [slam] mode =
-// localize): the image read by io::read_map_pgm_yaml and its cells classed by the YAML's
+// localize): the image read by io::read_map_yaml and its cells classed by the YAML's
 // thresholds as map_server does. `map.cells` points into `cells`: keep the object alive
 // (and unmoved) while the map is in use.
 struct LocalizationMap {

@@ -20,6 +20,7 @@
 
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
 
@@ -121,16 +122,17 @@ std::string sdp_loops_tsv(const SdpSlam& slam);
 // a time): an output step, not a per-scan one.
 std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image);
 
-// The bottom filter's pool members of a stats.json "pools" object (ancestry nodes, path
-// entries, observations, tiles: capacity, peak, exhausted), one per line indented by four
-// spaces, each ending with ",\n". Shared by the DP-SLAM and SDP-SLAM stats.
-std::string filter_pools_json(const DpSlamFilter& filter);
+// The bottom filter's members of a stats.json "pools" object (ancestry nodes, path
+// entries, observations, tiles: capacity, peak, exhausted), in that order; the caller adds
+// its own after them. Shared by the DP-SLAM and SDP-SLAM stats.
+io::Json filter_pools_json(const DpSlamFilter& filter);
 
-// The deterministic part of an SDP-SLAM stats.json: "segments" through "memory", one
-// member per line, each line indented by two spaces and ending with ",\n".
-// `arena_bytes` / `arena_used_bytes`: the arena given to init() and its used bytes;
-// `path_gaps`: from assemble_trajectory; `known_cells`: from sdp_global_map_image.
-std::string sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
-                           std::uint64_t path_gaps, std::uint32_t known_cells);
+// The deterministic part of an SDP-SLAM stats.json: the members "segments" through
+// "memory", in order, for the caller to append to its object (sdpslamd's status.json
+// "engine" takes the same). `arena_bytes` / `arena_used_bytes`: the arena given to init()
+// and its used bytes; `path_gaps`: from assemble_trajectory; `known_cells`: from
+// sdp_global_map_image.
+io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
+                        std::uint64_t path_gaps, std::uint32_t known_cells);
 
 }  // namespace sdpslam::slam
