@@ -89,6 +89,7 @@ bool SdpOptions::validate(char* why, std::size_t n) const {
   c.integer("max_loop_constraints", max_loop_constraints, 1U, capacity::kMaxLoopConstraints);
   c.integer("graph_iterations", graph_iterations, 1U, 50U);
   c.real("loop_search_window_m", loop_search_window_m, 0.0, 20.0);
+  c.real("loop_search_max_window_m", loop_search_max_window_m, 0.0, 50.0);
   c.real("loop_search_window_rad", loop_search_window_rad, 0.0, 3.14159265358979323846);
   c.real("loop_search_min_score", loop_search_min_score, 1.0e-6, 1.0);
   c.real("loop_search_max_ambiguity", loop_search_max_ambiguity, 1.0e-6, 1.0);

@@ -40,6 +40,7 @@ void apply_profile(SdpProfile profile, DpSlamOptions* bottom, SdpOptions* top) {
     top->max_levels = 8U;
     top->loop_closure = true;
     top->loop_search_window_m = 6.0;
+    top->loop_search_max_window_m = 16.0;
   }
 }
 

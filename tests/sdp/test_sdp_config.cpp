@@ -44,6 +44,7 @@ TEST(SdpConfig, shipped_default_sdp_section_loads_and_equals_the_built_in_defaul
   LONGS_EQUAL(d.max_loop_constraints, o.max_loop_constraints);
   LONGS_EQUAL(d.graph_iterations, o.graph_iterations);
   DOUBLES_EQUAL(d.loop_search_window_m, o.loop_search_window_m, 0.0);
+  DOUBLES_EQUAL(d.loop_search_max_window_m, o.loop_search_max_window_m, 0.0);
   DOUBLES_EQUAL(d.loop_search_window_rad, o.loop_search_window_rad, 0.0);
   DOUBLES_EQUAL(d.loop_search_min_score, o.loop_search_min_score, 0.0);
   DOUBLES_EQUAL(d.loop_search_max_ambiguity, o.loop_search_max_ambiguity, 0.0);
@@ -70,6 +71,7 @@ TEST(SdpConfig, shipped_default_file_leaves_the_profile_keys_to_the_profile) {
   LONGS_EQUAL(8, o.max_levels);
   CHECK_TRUE(o.loop_closure);
   DOUBLES_EQUAL(6.0, o.loop_search_window_m, 0.0);
+  DOUBLES_EQUAL(16.0, o.loop_search_max_window_m, 0.0);
 }
 
 TEST(SdpConfig, unknown_or_out_of_range_sdp_keys_are_rejected_with_file_and_line) {
@@ -132,6 +134,7 @@ TEST(SdpConfig, paper_profile_is_the_declared_defaults_and_changes_nothing) {
   LONGS_EQUAL(5, b.match.beam_stride);
   CHECK_FALSE(o.loop_closure);
   DOUBLES_EQUAL(0.0, o.loop_search_window_m, 0.0);
+  DOUBLES_EQUAL(0.0, o.loop_search_max_window_m, 0.0);
   LONGS_EQUAL(12, o.max_levels);
 }
 
@@ -171,6 +174,10 @@ TEST(SdpConfig, loop_closure_keys_are_parsed_and_range_checked) {
   DOUBLES_EQUAL(6.0, o.loop_search_window_m, 0.0);
   CHECK(slam::apply_sdp_key(&o, "loop_search_window_m", "25", &why) == slam::SdpKeyResult::kInvalid);
   CHECK_TRUE_TEXT(why.find("loop_search_window_m") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "loop_search_max_window_m", "51", &why) == slam::SdpKeyResult::kInvalid);
+  CHECK_TRUE_TEXT(why.find("loop_search_max_window_m") != std::string::npos, why.c_str());
+  CHECK(slam::apply_sdp_key(&o, "loop_search_max_window_m", "12", &why) == slam::SdpKeyResult::kApplied);
+  DOUBLES_EQUAL(12.0, o.loop_search_max_window_m, 0.0);
   CHECK(slam::apply_sdp_key(&o, "loop_search_min_score", "0", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "loop_search_candidates", "33", &why) == slam::SdpKeyResult::kInvalid);
   CHECK(slam::apply_sdp_key(&o, "loop_search_drift_m", "-1", &why) == slam::SdpKeyResult::kInvalid);

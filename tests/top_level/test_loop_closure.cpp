@@ -257,6 +257,44 @@ TEST(LoopClosure, a_large_correction_needs_a_later_level_that_agrees) {
   CHECK_EQUAL(0, rig->owner.verified);
 }
 
+// The chain drifted 9 m between levels 0 and 3 and 4 (loop_search_drift_m = 6 m: up to
+// 10.4 m over √3 hops), beyond the 6 m window. Without growth the search sees no room
+// (weak), with loop_search_max_window_m the window grows to the drift bound and finds
+// it; a peak that far still needs a second level's agreement, which level 4 gives.
+TEST(LoopClosure, the_window_grows_to_the_chains_drift_bound) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  const Pose2 truth4{1.0, 2.0, 0.2};
+  const Pose2 off{9.0, 0.0, 0.05};
+  const Pose2 believed3 = truth3.compose(off);
+  auto build = [&](double max_window_m) {
+    Owner& o = rig->owner;
+    o.levels.push_back({Pose2{}, room()});
+    o.levels.push_back({Pose2{0.0, 60.0, 0.0}, corridor(30.0)});
+    o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+    o.levels.push_back({believed3, seen_from(room(), Pose2{}, truth3)});
+    o.levels.push_back({believed3.compose(between(truth3, truth4)), seen_from(room(), Pose2{}, truth4)});
+    rig->options.loop_search_drift_m = 6.0;
+    rig->options.loop_search_max_window_m = max_window_m;
+    CHECK_TRUE(rig->init());
+    rig->search_all();
+  };
+  build(0.0);
+  CHECK_EQUAL(0U, rig->stats.loop_search_held);
+  CHECK_EQUAL(0U, rig->loops.record_count());
+  CHECK_TRUE(rig->stats.loop_search_weak >= 2U);  // levels 3 and 4 against level 0
+  delete rig;
+  rig = new Rig();
+  build(16.0);
+  CHECK_EQUAL(1U, rig->stats.loop_search_held);  // level 3's
+  CHECK_EQUAL(1U, rig->stats.loop_search_confirmed);
+  CHECK_EQUAL(2U, rig->loops.record_count());
+  for (std::uint32_t k = 0; k < 2U; ++k) {
+    const LoopClosure::Record& r = rig->loops.record(k);
+    CHECK_EQUAL(0U, r.older_level);
+    CHECK_TRUE(distance_m(r.z, r.newer_level == 3U ? truth3 : truth4) < 0.05);
+  }
+}
+
 // The top level's skeleton match, refined on obstacle points: one record per pair of
 // levels, the lower residual wins; a match that moves the submap farther than
 // loop_max_correction_m from its guess is not kept.

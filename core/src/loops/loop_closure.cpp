@@ -9,8 +9,13 @@ namespace {
 // The search's coarse pass works in blocks of this many grid cells.
 constexpr std::uint32_t kSearchCoarseCells = 4U;
 
+// The widest window a search may have (LoopClosure::search_window_m).
+double widest_window_m(const SdpOptions& s) {
+  return s.loop_search_max_window_m > s.loop_search_window_m ? s.loop_search_max_window_m : s.loop_search_window_m;
+}
+
 std::uint32_t search_steps(const SdpOptions& s, const LoopSearchGeometry& g) {
-  return CorrelativeMatcher::steps_for(s.loop_search_window_m, g.resolution_m, kSearchCoarseCells);
+  return CorrelativeMatcher::steps_for(widest_window_m(s), g.resolution_m, kSearchCoarseCells);
 }
 
 FrameGraphOptions graph_options(const SdpOptions& s, std::uint32_t max_nodes) {
@@ -283,7 +288,7 @@ void LoopClosure::search_pair(std::uint32_t older, std::uint32_t newer) {
   co.resolution_m = geometry_.resolution_m;
   co.coarse_cells = kSearchCoarseCells;
   co.kernel_sigma_m = 1.5 * co.resolution_m;
-  co.window_xy_m = options_.loop_search_window_m;
+  co.window_xy_m = search_window_m(older, newer);
   co.window_theta_rad = options_.loop_search_window_rad;
   co.min_score = options_.loop_search_min_score;
   co.max_ambiguity = options_.loop_search_max_ambiguity;
@@ -436,14 +441,29 @@ bool LoopClosure::centre_shift(const Record& r, double* dx_m, double* dy_m) cons
   return true;
 }
 
+// How far the chain can have drifted between two levels: loop_search_drift_m × √hops.
+double LoopClosure::drift_bound_m(std::uint32_t older_level, std::uint32_t newer_level) const {
+  return options_.loop_search_drift_m * det::sqrt(static_cast<double>(level_hops(older_level, newer_level)));
+}
+
+// loop_search_window_m, grown to the drift bound up to loop_search_max_window_m
+// (SdpOptions::loop_search_max_window_m says why).
+double LoopClosure::search_window_m(std::uint32_t older_level, std::uint32_t newer_level) const {
+  const double w = options_.loop_search_window_m;
+  if (!(options_.loop_search_max_window_m > w) || !(options_.loop_search_drift_m > 0.0)) return w;
+  const double bound = drift_bound_m(older_level, newer_level);
+  if (!(bound > w)) return w;
+  return bound < options_.loop_search_max_window_m ? bound : options_.loop_search_max_window_m;
+}
+
 // Whether r would move its newer submap farther than the chain may have drifted between
 // the two levels: loop_search_drift_m × √hops (SdpOptions::loop_search_drift_m).
 bool LoopClosure::moves_too_far(const Record& r) const {
   double dx = 0.0;
   double dy = 0.0;
   if (!centre_shift(r, &dx, &dy)) return false;
-  const double limit_m2 = options_.loop_search_drift_m * options_.loop_search_drift_m *
-                          static_cast<double>(level_hops(r.older_level, r.newer_level));
+  const double bound = drift_bound_m(r.older_level, r.newer_level);
+  const double limit_m2 = bound * bound;
   return dx * dx + dy * dy > limit_m2;
 }
 

@@ -243,6 +243,7 @@ SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* va
   else if (key == "max_loop_constraints") ok = integer(&t.max_loop_constraints);
   else if (key == "graph_iterations") ok = integer(&t.graph_iterations);
   else if (key == "loop_search_window_m") ok = real(&t.loop_search_window_m);
+  else if (key == "loop_search_max_window_m") ok = real(&t.loop_search_max_window_m);
   else if (key == "loop_search_window_rad") ok = real(&t.loop_search_window_rad);
   else if (key == "loop_search_min_score") ok = real(&t.loop_search_min_score);
   else if (key == "loop_search_max_ambiguity") ok = real(&t.loop_search_max_ambiguity);

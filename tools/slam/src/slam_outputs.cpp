@@ -289,6 +289,7 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                         {"graph_refused", st.frame_graph_refused},
                         {"search",
                          {{"window_m", fixed(so.loop_search_window_m, 3)},
+                          {"max_window_m", fixed(so.loop_search_max_window_m, 3)},
                           {"pairs", st.loop_searches},
                           {"weak", st.loop_search_weak},
                           {"ambiguous", st.loop_search_ambiguous},

@@ -149,6 +149,14 @@ struct SdpOptions {
   // reaching loop_search_max_ambiguity × it) refined by obstacle ICP with the
   // loop_max_error_m / loop_min_pairs tests becomes a loop constraint. 0 = off.
   double loop_search_window_m = 0.0;           // [0, 20]
+  // The window grows beyond loop_search_window_m, up to this, for a pair of levels whose
+  // chain can have drifted farther (loop_search_drift_m × √hops, below): the search is
+  // exact in its window, so a window narrower than the drift leaves the true place
+  // unsearched and an alias inside it unique. A wider window sees both, and a repeated
+  // structure becomes ambiguous instead of a wrong loop. Peaks beyond half of
+  // loop_search_window_m still wait for a second opinion. Cost: the grid reads grow
+  // as the window squared, spread over scans by loop_search_reads_per_scan. 0 = no growth.
+  double loop_search_max_window_m = 0.0;       // [0, 50]
   // ±0.6 rad: a cheap robot's heading is commonly 30° off after a long loop, and a single
   // bad turn of the bottom level can leave a quarter radian; the search is exact within
   // its window, so a drift just outside it is a loop lost.

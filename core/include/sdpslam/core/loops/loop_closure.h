@@ -26,7 +26,8 @@
 // closed to within decimetres, so once per level the chosen submap is also searched
 // against up to loop_search_candidates older, non-adjacent submaps whose boxes (grown by
 // the window) overlap its own, exhaustively over ±loop_search_window_m and
-// ±loop_search_window_rad (correlative_matcher.h), in slices of
+// ±loop_search_window_rad (correlative_matcher.h; the window grows to the chain's drift
+// bound between the two levels, up to loop_search_max_window_m), in slices of
 // loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak scoring
 // loop_search_min_score that obstacle ICP confirms becomes a constraint unless it would
 // move the newer submap farther than the chain can have drifted
@@ -172,6 +173,8 @@ class LoopClosure {
   double corner_distance(const double a[8], const double b[8]) const;
   bool centre_shift(const Record& r, double* dx_m, double* dy_m) const;
   bool moves_too_far(const Record& r) const;
+  double drift_bound_m(std::uint32_t older_level, std::uint32_t newer_level) const;
+  double search_window_m(std::uint32_t older_level, std::uint32_t newer_level) const;
   std::uint32_t level_hops(std::uint32_t older_level, std::uint32_t newer_level) const;
 
   SdpOptions options_{};
