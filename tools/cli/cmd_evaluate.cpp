@@ -229,13 +229,13 @@ int run_ate(const EvaluateArgs& a, io::Json* json) {
               "along-track scale %+.3f %%\n",
               q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
               100.0 * q.scale_error);
-  ate["rpe"] = {{"distance_m", q.distance_m},
-                {"stretch_count", q.stretch_count},
-                {"mean_m", q.mean_m},
-                {"rmse_m", q.rmse_m},
-                {"max_m", q.max_m},
-                {"heading_mean_deg", q.heading_mean_rad * kRadToDeg},
-                {"scale_error", q.scale_error}};
+  (*json)["rpe"] = {{"distance_m", q.distance_m},
+                    {"stretch_count", q.stretch_count},
+                    {"mean_m", q.mean_m},
+                    {"rmse_m", q.rmse_m},
+                    {"max_m", q.max_m},
+                    {"heading_mean_deg", q.heading_mean_rad * kRadToDeg},
+                    {"scale_error", q.scale_error}};
   return kExitOk;
 }
 
