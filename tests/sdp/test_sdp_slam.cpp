@@ -648,6 +648,54 @@ TEST(SdpSlam, the_best_map_is_made_of_the_permanent_map_live_submaps_and_the_cur
   LONGS_EQUAL(0, pm.refused_no_tile());
 }
 
+TEST(SdpSlam, a_full_permanent_map_is_coarsened_drawn_whole_and_changes_no_pose) {
+  // The same run with the permanent map's tiles plentiful and with a store far too small
+  // for it: the small one is compacted instead of refusing copies, every cell it keeps is
+  // drawn as the block of fine cells it covers, and the trajectory is the same bit for
+  // bit (the permanent map is an output, not an input of the filter).
+  const test::ScanSet set(3);
+  SdpOptions roomy = test::small_sdp_options();
+  SdpOptions tight = roomy;
+  tight.permanent_map_tiles = 6U;
+  test::SdpRig a;
+  test::SdpRig b;
+  CHECK_TRUE(a.init(test::sim_options(5), roomy, 11));
+  CHECK_TRUE(b.init(test::sim_options(5), tight, 11));
+  test::CollectPoses sa;
+  test::CollectPoses sb;
+  const Trace ta = run_sdp(a, set, &sa);
+  const Trace tb = run_sdp(b, set, &sb);
+  const PermanentMap& pa = a.slam->permanent_map();
+  const PermanentMap& pb = b.slam->permanent_map();
+  LONGS_EQUAL(0, pa.compactions());
+  CHECK(pb.compactions() > 0U);
+  LONGS_EQUAL(pb.compactions(), pb.scale_log2());
+  LONGS_EQUAL(0, pb.refused_no_tile());
+  LONGS_EQUAL(0, b.slam->stats().map_transfer_dropped);
+  CHECK(pb.tiles_used() <= 6U);
+  LONGS_EQUAL(ta.poses.size(), tb.poses.size());
+  for (std::size_t i = 0; i < ta.poses.size(); ++i) {
+    CHECK(ta.poses[i].x_m == tb.poses[i].x_m && ta.poses[i].y_m == tb.poses[i].y_m &&
+          ta.poses[i].heading_rad == tb.poses[i].heading_rad);
+  }
+  // Drawn: each kept cell as its 2^s x 2^s fine cells, covering the roomy map's extent.
+  const std::uint64_t block = std::uint64_t{1} << (2U * pb.scale_log2());
+  std::uint64_t drawn = 0U;
+  double bx[4] = {1e300, 1e300, -1e300, -1e300};
+  b.slam->for_each_permanent_cell([&](double x, double y, const CellObservation&) {
+    ++drawn;
+    bx[0] = x < bx[0] ? x : bx[0];
+    bx[1] = y < bx[1] ? y : bx[1];
+    bx[2] = x > bx[2] ? x : bx[2];
+    bx[3] = y > bx[3] ? y : bx[3];
+  });
+  LONGS_EQUAL(pb.known_cells() * block, drawn);
+  const double side_m = a.slam->bottom().map().resolution_m() * static_cast<double>(std::uint64_t{1} << pb.scale_log2());
+  a.slam->for_each_permanent_cell([&](double x, double y, const CellObservation&) {
+    CHECK(x >= bx[0] - side_m && x <= bx[2] + side_m && y >= bx[1] - side_m && y <= bx[3] + side_m);
+  });
+}
+
 namespace {
 
 // A corridor 3 m wide and 106 m long with pilasters at irregular spacing on both walls,

@@ -121,12 +121,17 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   *image = io::OccupancyImage{};
   const DpSlamFilter& f = slam.bottom();
   const DpMap& map = f.map();
-  const double res = map.resolution_m();
+  // The image has the resolution the permanent part kept: the DP map's, or coarser once
+  // a full store was compacted (PermanentMap::compact), so that a large building's image
+  // stays as small as what the core holds of it. Finer cells (the live submaps) are
+  // summed into the image's.
+  const double res = map.resolution_m() * static_cast<double>(std::uint64_t{1} << slam.permanent_map().scale_log2());
+  const double fine = map.resolution_m();
   const double ox = map.options().origin_x_m;
   const double oy = map.options().origin_y_m;
   // Bounds in the global frame.
   double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
-  const double half = 0.5 * res;
+  const double half = 0.5 * fine;
   slam.for_each_permanent_cell([&](double x, double y, const CellObservation&) {
     gx0 = std::min(gx0, x - half);
     gy0 = std::min(gy0, y - half);
@@ -135,8 +140,8 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   });
   slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
     if (r.width == 0U || r.height == 0U) return;
-    const double xs[2] = {ox + r.ix0 * res, ox + (r.ix0 + static_cast<double>(r.width)) * res};
-    const double ys[2] = {oy + r.iy0 * res, oy + (r.iy0 + static_cast<double>(r.height)) * res};
+    const double xs[2] = {ox + r.ix0 * fine, ox + (r.ix0 + static_cast<double>(r.width)) * fine};
+    const double ys[2] = {oy + r.iy0 * fine, oy + (r.iy0 + static_cast<double>(r.height)) * fine};
     for (double x : xs) {
       for (double y : ys) {
         double gx = 0.0, gy = 0.0;
@@ -308,6 +313,9 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
   pools["permanent_map_tiles"] = {{"capacity", pmap.tile_capacity()},
                                   {"used", pmap.tiles_used()},
                                   {"known_cells", pmap.known_cells()},
+                                  {"compactions", pmap.compactions()},
+                                  {"cell_m", fixed(bottom.map().resolution_m() *
+                                                       static_cast<double>(std::uint64_t{1} << pmap.scale_log2()), 3)},
                                   {"exhausted", pmap.refused_no_tile()}};
   pools["pose_ring"] = {{"capacity", slam.pose_ring_capacity()},
                         {"peak", st.pose_ring_peak},

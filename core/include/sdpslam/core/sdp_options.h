@@ -85,7 +85,9 @@ struct SdpOptions {
   std::uint32_t map_observation_capacity = 1505000U;
   // [sdp] tiles of the global map's permanent part (permanent_map.h), 16 × 16 cells of
   // 8 bytes each (2 KiB), wherever they are: 4096 tiles hold 2,600 m² of mapped floor at
-  // 5 cm. A copy into a full map is refused and counted (map_transfer_dropped).
+  // 5 cm. A full map is coarsened (PermanentMap::compact: 2 × 2 cells into one, each
+  // time counted) rather than refusing copies; only past its coarsest scale is a copy
+  // refused and counted (map_transfer_dropped).
   std::uint32_t permanent_map_tiles = 4096U;
   // [sdp] the DP map's (owner, cell) index (DpMap::Options::owner_cell_index) for the
   // bottom level: off by default, its ~17 MB would break the memory budget, and with N

@@ -600,13 +600,22 @@ void SdpSlam::for_each_permanent_cell(F&& f) const {
         correction = pm.frame_in_global.compose(pm.frame_in_map.inverse());
       }
     }
-    double x = 0.0;
-    double y = 0.0;
-    filter_->map().cell_center(ix, iy, &x, &y);
-    double gx = 0.0;
-    double gy = 0.0;
-    correction.transform_point(x, y, gx, gy);
-    f(gx, gy, c.value);
+    // A coarsened cell (PermanentMap::compact) stands for the block of fine cells it
+    // covers: each is drawn with its value.
+    const std::uint32_t s = permanent_map_.scale_log2();
+    const std::int64_t side = std::int64_t{1} << s;
+    for (std::int64_t b = 0; b < side; ++b) {
+      for (std::int64_t a = 0; a < side; ++a) {
+        double x = 0.0;
+        double y = 0.0;
+        filter_->map().cell_center(static_cast<std::int32_t>(static_cast<std::int64_t>(ix) * side + a),
+                                   static_cast<std::int32_t>(static_cast<std::int64_t>(iy) * side + b), &x, &y);
+        double gx = 0.0;
+        double gy = 0.0;
+        correction.transform_point(x, y, gx, gy);
+        f(gx, gy, c.value);
+      }
+    }
   });
 }
 

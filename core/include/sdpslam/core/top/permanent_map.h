@@ -26,8 +26,23 @@
 // bytes per cell of each touched tile instead of ~32 bytes per known cell (an
 // observation slot and its pool links) in the shared observation pool, so the bottom level's map no longer competes with it.
 //
+// Full store: compacted, not lost (issue: memory is fixed, the world is not). When a
+// write needs a new tile and every tile is taken, the whole map is coarsened once:
+// every 2×2 block of cells becomes one cell (counts summed with accumulate(), the tag of
+// the block's largest contribution kept, as for two levels writing one cell), so every
+// 2×2 block of tiles becomes one tile and about three tiles in four are freed where the
+// map is dense. Cells are then kept at twice the side (scale_log2() counts the halvings)
+// and every later write lands in the cell covering it; the map is drawn at the DP map's
+// resolution, each coarse cell as the block of fine cells it covers
+// (SdpSlam::for_each_permanent_cell). Each compaction is counted and reported
+// (compactions(), stats.json), as is the cell side it left. Cost: one pass over the
+// stored cells (tile_capacity × 256), with a sort of the tile slots, only when the store
+// is full. Up to kMaxScaleLog2 halvings (a 5 cm grid becomes 12.8 m cells): beyond that
+// a write into a new tile is refused and counted (refused_no_tile), the only refusal.
+//
 // Errors are results and counters: a write with tag 0, or into a new tile when every
-// tile is taken, returns false and is counted; the map stays consistent.
+// tile is taken and the map is as coarse as it may become, returns false and is counted;
+// the map stays consistent.
 #include <cstddef>
 #include <cstdint>
 
@@ -56,17 +71,23 @@ class PermanentMap {
   // is too small (the map then refuses every write). Call once.
   bool init(Arena& arena, std::uint32_t tile_capacity);
 
-  // Adds (hits, misses) to cell (ix, iy) with `tag` (> 0). False, counted, iff the tag is
-  // 0 or the map is not initialised (refused_untagged), or the cell's tile is new and
-  // every tile is taken (refused_no_tile). O(1) expected.
+  // Halvings of the cell side the store may make when full (see the header comment).
+  static constexpr std::uint32_t kMaxScaleLog2 = 8U;
+
+  // Adds (hits, misses) to the cell covering fine cell (ix, iy) with `tag` (> 0). False,
+  // counted, iff the tag is 0 or the map is not initialised (refused_untagged), or the
+  // cell's tile is new, every tile is taken and the map is already kMaxScaleLog2 times
+  // coarsened (refused_no_tile). O(1) expected; a compaction when the store is full.
   bool add(std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses, std::uint32_t tag);
 
-  // The cell (ix, iy); tag 0 when unknown. O(1) expected.
+  // The cell covering fine cell (ix, iy); tag 0 when unknown. O(1) expected.
   Cell cell(std::int32_t ix, std::int32_t iy) const;
 
-  // f(ix, iy, const Cell&) for every known cell, tile by tile in row-major order of the
-  // tiles' coordinates (deterministic, whatever order they were written in), row-major
-  // within a tile. O(tiles in the bounding box of the used ones).
+  // f(ix, iy, const Cell&) for every known cell, in the coordinates of the current scale
+  // (a cell covers fine cells [ix·2^s, (ix+1)·2^s) × [iy·2^s, (iy+1)·2^s), s =
+  // scale_log2()), tile by tile in row-major order of the tiles' coordinates
+  // (deterministic, whatever order they were written in), row-major within a tile.
+  // O(tiles in the bounding box of the used ones).
   template <class F>
   void for_each_cell(F&& f) const;
 
@@ -75,6 +96,10 @@ class PermanentMap {
   std::uint64_t known_cells() const { return known_cells_; }
   std::uint64_t refused_untagged() const { return refused_untagged_; }
   std::uint64_t refused_no_tile() const { return refused_no_tile_; }
+  // Halvings of the cell side so far (0: the DP map's resolution), and how many times the
+  // store was full and compacted (equal: one halving per compaction).
+  std::uint32_t scale_log2() const { return scale_log2_; }
+  std::uint64_t compactions() const { return compactions_; }
   bool initialised() const { return table_ != nullptr; }
 
  private:
@@ -100,6 +125,17 @@ class PermanentMap {
   std::uint32_t find_slot(std::int32_t ix, std::int32_t iy) const {
     return table_ == nullptr ? kNone : table_[probe(tile_key(ix, iy))];
   }
+  // The fine cell (ix, iy) in the coordinates of the current scale.
+  std::int32_t coarse(std::int32_t v) const;
+  // Inserts a fresh tile for the scaled cell (ix, iy) at table position `at`; false iff
+  // every tile is taken.
+  bool new_tile(std::uint32_t at, std::uint64_t key, std::int32_t ix, std::int32_t iy);
+  // Coarsens the whole store once (header comment); false iff it is already at
+  // kMaxScaleLog2.
+  bool compact();
+  // Rebuilds the table, the bounding box and the known-cell count from slots
+  // [0, tiles_used_).
+  void reindex();
   // Cell (ix, iy) inside the tile stored at `slot`.
   Cell& cell_in(std::uint32_t slot, std::int32_t ix, std::int32_t iy) const {
     const std::uint32_t in_tile = ((static_cast<std::uint32_t>(iy) & (kSide - 1U)) << kSideLog2) +
@@ -114,6 +150,12 @@ class PermanentMap {
   std::uint32_t table_shift_ = 63U;  // 64 − log2(table entries)
   std::uint64_t* keys_ = nullptr;    // tile_capacity_: each slot's tile key
   Cell* cells_ = nullptr;            // tile_capacity_ × kCells
+  std::uint32_t* order_ = nullptr;   // tile_capacity_: compact()'s slots sorted by new key
+  std::uint64_t* new_keys_ = nullptr;  // tile_capacity_: each slot's key after the halving
+  Cell* scratch_ = nullptr;          // kCells: the tile being merged
+  std::uint32_t* scratch_weight_ = nullptr;  // kCells: its cells' counts merged so far
+  std::uint32_t scale_log2_ = 0U;
+  std::uint64_t compactions_ = 0U;
   // Bounding box of the used tiles, in tile coordinates (for_each_cell's order).
   std::int32_t tx0_ = 0, ty0_ = 0, tx1_ = -1, ty1_ = -1;
   std::uint64_t known_cells_ = 0U;

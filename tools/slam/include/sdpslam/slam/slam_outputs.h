@@ -117,7 +117,8 @@ std::string sdp_loops_tsv(const SdpSlam& slam);
 // The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map (each cell
 // moved with its level's frame as loop closure corrected it) plus
 // each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
-// misses summed per cell; aligned to the DP map's grid. Returns the known cells; `image`
+// misses summed per cell; aligned to the DP map's grid, at its resolution or, once the
+// permanent map was coarsened, at the permanent map's cell size. Returns the known cells; `image`
 // stays empty (width 0) when nothing was ever written. Allocates (the image, one view at
 // a time): an output step, not a per-scan one.
 std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image);
