@@ -85,18 +85,20 @@ bool PermanentMap::new_tile(std::uint32_t at, std::uint64_t key, std::int32_t ix
   keys_[slot] = key;
   Cell* tile = cells_ + static_cast<std::size_t>(slot) * kCells;
   for (std::uint32_t i = 0; i < kCells; ++i) tile[i] = Cell{};
-  const std::int32_t tx = floor_shift(ix, kSideLog2);
-  const std::int32_t ty = floor_shift(iy, kSideLog2);
+  include_tile(slot, floor_shift(ix, kSideLog2), floor_shift(iy, kSideLog2));
+  return true;
+}
+
+void PermanentMap::include_tile(std::uint32_t slot, std::int32_t tx, std::int32_t ty) {
   if (slot == 0U) {
     tx0_ = tx1_ = tx;
     ty0_ = ty1_ = ty;
-  } else {
-    if (tx < tx0_) tx0_ = tx;
-    if (tx > tx1_) tx1_ = tx;
-    if (ty < ty0_) ty0_ = ty;
-    if (ty > ty1_) ty1_ = ty;
+    return;
   }
-  return true;
+  if (tx < tx0_) tx0_ = tx;
+  if (tx > tx1_) tx1_ = tx;
+  if (ty < ty0_) ty0_ = ty;
+  if (ty > ty1_) ty1_ = ty;
 }
 
 void PermanentMap::reindex() {
@@ -106,17 +108,8 @@ void PermanentMap::reindex() {
   tx1_ = ty1_ = -1;
   for (std::uint32_t slot = 0; slot < tiles_used_; ++slot) {
     table_[probe(keys_[slot])] = slot;
-    const std::int32_t tx = floor_shift(origin_of(keys_[slot], kSideLog2), kSideLog2);
-    const std::int32_t ty = floor_shift(origin_of(keys_[slot] >> 32U, kSideLog2), kSideLog2);
-    if (slot == 0U) {
-      tx0_ = tx1_ = tx;
-      ty0_ = ty1_ = ty;
-    } else {
-      if (tx < tx0_) tx0_ = tx;
-      if (tx > tx1_) tx1_ = tx;
-      if (ty < ty0_) ty0_ = ty;
-      if (ty > ty1_) ty1_ = ty;
-    }
+    include_tile(slot, floor_shift(origin_of(keys_[slot], kSideLog2), kSideLog2),
+                 floor_shift(origin_of(keys_[slot] >> 32U, kSideLog2), kSideLog2));
     const Cell* tile = cells_ + static_cast<std::size_t>(slot) * kCells;
     for (std::uint32_t i = 0; i < kCells; ++i) known_cells_ += tile[i].tag != 0U ? 1U : 0U;
   }

@@ -130,6 +130,8 @@ class PermanentMap {
   // Inserts a fresh tile for the scaled cell (ix, iy) at table position `at`; false iff
   // every tile is taken.
   bool new_tile(std::uint32_t at, std::uint64_t key, std::int32_t ix, std::int32_t iy);
+  // Grows the used tiles' bounding box by tile (tx, ty), stored at `slot` (slot 0 starts it).
+  void include_tile(std::uint32_t slot, std::int32_t tx, std::int32_t ty);
   // Coarsens the whole store once (header comment); false iff it is already at
   // kMaxScaleLog2.
   bool compact();
