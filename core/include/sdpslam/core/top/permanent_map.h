@@ -28,13 +28,13 @@
 //
 // Full store: compacted, not lost (issue: memory is fixed, the world is not). When a
 // write needs a new tile and every tile is taken, the whole map is coarsened once:
-// every 2×2 block of cells becomes one cell (counts summed with accumulate(), the tag of
-// the block's largest contribution kept, as for two levels writing one cell), so every
+// every 2×2 block of cells becomes one cell (counts summed with accumulate(), the tag
+// chosen by add()'s rule as if the four cells were written into it in turn), so every
 // 2×2 block of tiles becomes one tile and about three tiles in four are freed where the
 // map is dense. Cells are then kept at twice the side (scale_log2() counts the halvings)
-// and every later write lands in the cell covering it; the map is drawn at the DP map's
-// resolution, each coarse cell as the block of fine cells it covers
-// (SdpSlam::for_each_permanent_cell). Each compaction is counted and reported
+// and every later write lands in the cell covering it. SdpSlam::for_each_permanent_cell
+// gives each coarse cell as the block of fine cells it covers, and the global map image
+// is drawn at the coarse cell's size. Each compaction is counted and reported
 // (compactions(), stats.json), as is the cell side it left. Cost: one pass over the
 // stored cells (tile_capacity × 256), with a sort of the tile slots, only when the store
 // is full. Up to kMaxScaleLog2 halvings (a 5 cm grid becomes 12.8 m cells): beyond that
