@@ -237,7 +237,7 @@ SdpStats run_loop_search(const test::ScanSet& set, const SdpOptions& o, double* 
   const SdpStats st = r.slam->stats();
   LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
                                     st.loop_search_refuted + st.loop_search_closed + st.loop_search_far +
-                                    st.loop_search_held);
+                                    st.loop_search_recentred);
   return st;
 }
 }  // namespace
@@ -353,7 +353,7 @@ TEST(SdpSlam, wide_loop_search_adds_constraints_beyond_icp_reach) {
     // Every search ends in exactly one outcome.
     LONGS_EQUAL(st.loop_searches, st.loop_search_weak + st.loop_search_ambiguous + st.loop_search_failed +
                                       st.loop_search_refuted + st.loop_search_closed + st.loop_search_far +
-                                    st.loop_search_held);
+                                    st.loop_search_recentred);
     CHECK(st.loop_records_added > a.slam->stats().loop_records_added);
     CHECK_TRUE(b.slam->graph().invariants_hold());
     icp_only_m += mean_error_to_truth(ta, set) / 3.0;

@@ -27,15 +27,6 @@ FrameGraphOptions graph_options(const SdpOptions& s, std::uint32_t max_nodes) {
   return o;
 }
 
-// The four corners of a box (submap frame: x0, y0, x1, y1) placed by `frame`, as x, y pairs.
-void box_corners(const Pose2& frame, const double b[4], double out[8]) {
-  for (std::uint32_t i = 0; i < 4U; ++i) {
-    const Pose2 c = frame.compose(Pose2{(i & 1U) != 0U ? b[2] : b[0], (i & 2U) != 0U ? b[3] : b[1], 0.0});
-    out[2U * i] = c.x_m;
-    out[2U * i + 1U] = c.y_m;
-  }
-}
-
 }  // namespace
 
 std::size_t LoopClosure::required_bytes(const SdpOptions& s, std::uint32_t max_nodes, const LoopSearchGeometry& g) {
@@ -60,7 +51,7 @@ bool LoopClosure::init(const SdpOptions& s, std::uint32_t max_nodes, const LoopS
   search_level_ = 0U;
   search_count_ = 0U;
   search_cursor_ = 0U;
-  held_count_ = 0U;
+  recentring_ = false;
   records_ = arena.allocate_array<Record>(s.max_loop_constraints);
   if (records_ == nullptr || !graph_.init(graph_options(s, max_nodes), arena)) return false;
   if (s.loop_search_window_m > 0.0) {
@@ -284,19 +275,24 @@ void LoopClosure::search_pair(std::uint32_t older, std::uint32_t newer) {
   search_pair_newer_ = newer;
   search_a_count_ = tn;
   search_b_count_ = sn;
-  CorrelativeOptions co;
-  co.resolution_m = geometry_.resolution_m;
-  co.coarse_cells = kSearchCoarseCells;
-  co.kernel_sigma_m = 1.5 * co.resolution_m;
-  co.window_xy_m = search_window_m(older, newer);
-  co.window_theta_rad = options_.loop_search_window_rad;
-  co.min_score = options_.loop_search_min_score;
-  co.max_ambiguity = options_.loop_search_max_ambiguity;
-  if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), co)) {
+  recentring_ = false;
+  if (!matcher_.begin(search_a_, tn, search_b_, sn, tframe.inverse().compose(sframe), search_options(older, newer))) {
     ++stats_->loop_search_failed;
     return;
   }
   search_continue();
+}
+
+CorrelativeOptions LoopClosure::search_options(std::uint32_t older_level, std::uint32_t newer_level) const {
+  CorrelativeOptions co;
+  co.resolution_m = geometry_.resolution_m;
+  co.coarse_cells = kSearchCoarseCells;
+  co.kernel_sigma_m = 1.5 * co.resolution_m;
+  co.window_xy_m = search_window_m(older_level, newer_level);
+  co.window_theta_rad = options_.loop_search_window_rad;
+  co.min_score = options_.loop_search_min_score;
+  co.max_ambiguity = options_.loop_search_max_ambiguity;
+  return co;
 }
 
 // The coarse pass within the per-scan budget; the fine pass, ICP and the verdict when
@@ -308,6 +304,10 @@ void LoopClosure::search_continue() {
   if (h > 0xFFFFFFFFULL) h = 0xFFFFFFFFULL;
   if (!matcher_.advance(static_cast<std::uint32_t>(h))) return;
   const CorrelativeResult c = matcher_.finish();
+  if (recentring_) {
+    recentre_verdict(c);
+    return;
+  }
   if (c.status == CorrelativeResult::Status::kWeak) {
     ++stats_->loop_search_weak;
     return;
@@ -336,7 +336,7 @@ void LoopClosure::search_continue() {
     ++stats_->loop_search_far;
     return;
   }
-  search_second_opinion(lr);
+  search_verdict(lr);
 }
 
 // The search proves a peak unique only within its window, which is centred on where the
@@ -344,79 +344,55 @@ void LoopClosure::search_continue() {
 // half the window has the other half on every side of it searched too: a repeated
 // structure at up to that distance from it would have shown as a rival peak
 // (kAmbiguous), so it is accepted. A peak farther out had part of its surroundings
-// outside the window, where its alias (or the true place) may lie unseen: one such
-// peak is not enough. It is held until the search of another (later) level finds a
-// peak that places that level within loop_max_correction_m (every corner of its box)
-// of where the held one does; both then become constraints. A true revisit goes on for
-// more than one segment, so later levels see the same place again through other walls;
-// an alias is rarely repeated at the same offset from different structure. (The
-// consistency check of ORB-SLAM's loop candidates, Mur-Artal et al. 2015, §VI-A, on
-// submaps.) Held peaks wait in a small FIFO; the oldest gives way.
-void LoopClosure::search_second_opinion(const Record& r) {
-  double via_r[8];
+// outside the window, where its alias may lie unseen. So the pair is searched again
+// with the same window centred on the peak: if the peak is still the unique best there
+// (recentre_verdict()), no alias lies within a window of it on any side, and the
+// first search showed none between it and where the chain puts the submap; it is
+// accepted. Otherwise it is dropped. The exactness of each search in its window is
+// what makes the two windows together a proof of uniqueness.
+void LoopClosure::search_verdict(const Record& r) {
   double dx = 0.0;
   double dy = 0.0;
-  if (!corners_via(r, r.newer_level, via_r) || !centre_shift(r, &dx, &dy)) {
+  if (!centre_shift(r, &dx, &dy)) {
     ++stats_->loop_search_failed;  // a level was forgotten while it was searched
     return;
   }
-  const double tol = options_.loop_max_correction_m;
   const double half = 0.5 * options_.loop_search_window_m;
   if (dx * dx + dy * dy <= half * half) {
     search_accept(r);
     return;
   }
-  for (std::uint32_t k = 0; k < held_count_; ++k) {
-    const Record& h = held_[k];
-    if (h.newer_level == r.newer_level) continue;  // the same submap sees the same structure
-    double via_h[8];
-    if (!corners_via(h, r.newer_level, via_h) || corner_distance(via_h, via_r) > tol) continue;
-    const Record confirmed = h;
-    for (std::uint32_t j = k + 1U; j < held_count_; ++j) held_[j - 1U] = held_[j];
-    --held_count_;
-    ++stats_->loop_search_confirmed;  // its search was counted held
-    record(confirmed);
-    search_accept(r);
+  ++stats_->loop_search_recentred;
+  if (!matcher_.begin(search_a_, search_a_count_, search_b_, search_b_count_, r.z,
+                      search_options(r.older_level, r.newer_level))) {
+    return;  // cannot happen: the same sets passed begin() for the first search
+  }
+  recentring_ = true;
+  recentred_ = r;
+  search_continue();
+}
+
+// The re-centred search agrees when its best pose is the peak itself (not distinct from
+// it) and unambiguous.
+void LoopClosure::recentre_verdict(const CorrelativeResult& c) {
+  recentring_ = false;
+  if (!c.found()) return;
+  const CorrelativeOptions co;
+  const Pose2 d = between(recentred_.z, c.transform);
+  if (d.x_m * d.x_m + d.y_m * d.y_m > co.distinct_m * co.distinct_m ||
+      det::detail::fabs(d.heading_rad) > co.distinct_rad) {
     return;
   }
-  if (held_count_ == kHeldLoops) {
-    for (std::uint32_t j = 1U; j < held_count_; ++j) held_[j - 1U] = held_[j];
-    --held_count_;
-  }
-  held_[held_count_++] = r;
-  ++stats_->loop_search_held;
-}
-
-bool LoopClosure::corners_via(const Record& r, std::uint32_t level, double out[8]) const {
-  std::uint32_t n = 0U;
-  Pose2 fo;
-  Pose2 fn;
-  Pose2 fl;
-  double ob[4];
-  double nb[4];
-  double lb[4];
-  if (!submaps_->placement(r.older_level, &fo, ob, &n) || !submaps_->placement(r.newer_level, &fn, nb, &n) ||
-      !submaps_->placement(level, &fl, lb, &n) || !box_valid(lb)) {
-    return false;
-  }
-  // The level's frame as r places it: older frame, r, then the chain from r's newer level.
-  box_corners(fo.compose(r.z).compose(fn.inverse().compose(fl)), lb, out);
-  return true;
-}
-
-double LoopClosure::corner_distance(const double a[8], const double b[8]) const {
-  double worst = 0.0;
-  for (std::uint32_t i = 0; i < 4U; ++i) {
-    const double dx = a[2U * i] - b[2U * i];
-    const double dy = a[2U * i + 1U] - b[2U * i + 1U];
-    const double d2 = dx * dx + dy * dy;
-    if (d2 > worst) worst = d2;
-  }
-  return det::sqrt(worst);
+  ++stats_->loop_search_recentred_closed;  // its search was counted recentred, not closed
+  keep_verified(recentred_);
 }
 
 void LoopClosure::search_accept(const Record& r) {
   ++stats_->loop_search_closed;
+  keep_verified(r);
+}
+
+void LoopClosure::keep_verified(const Record& r) {
   record(r);
   if (!record_dead(r)) submaps_->on_verified_loop();  // the frames follow the new constraint now
 }

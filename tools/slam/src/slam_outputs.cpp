@@ -302,8 +302,8 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                           {"refuted", st.loop_search_refuted},
                           {"closed", st.loop_search_closed},
                           {"far", st.loop_search_far},
-                          {"held", st.loop_search_held},
-                          {"confirmed", st.loop_search_confirmed}}}};
+                          {"recentred", st.loop_search_recentred},
+                          {"recentred_closed", st.loop_search_recentred_closed}}}};
   io::Json pools = filter_pools_json(bottom);
   pools["pgs_levels"] = {{"capacity", so.max_levels}, {"peak", g.peak_levels_used()}, {"refused", st.pgs_refused}};
   pools["permanent_submaps"] = {{"capacity", so.max_permanent_submaps},

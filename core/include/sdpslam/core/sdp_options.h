@@ -156,7 +156,7 @@ struct SdpOptions {
   // exact in its window, so a window narrower than the drift leaves the true place
   // unsearched and an alias inside it unique. A wider window sees both, and a repeated
   // structure becomes ambiguous instead of a wrong loop. Peaks beyond half of
-  // loop_search_window_m still wait for a second opinion. Cost: the grid reads grow
+  // loop_search_window_m are searched again around themselves. Cost: the grid reads grow
   // as the window squared, spread over scans by loop_search_reads_per_scan. 0 = no growth.
   double loop_search_max_window_m = 0.0;       // [0, 50]
   // ±0.6 rad: a cheap robot's heading is commonly 30° off after a long loop, and a single
@@ -172,12 +172,11 @@ struct SdpOptions {
   // drifts like a random walk; a recorded loop is a short cut). Repeated structure
   // (doors, pillars at a regular pitch) makes peaks that are metres off and would pull
   // the map apart; a true loop's correction grows like the chain's random-walk drift.
-  // A credible peak that moves the newer submap by more than half the window waits for
-  // a later level's search to agree with it (loop_closure.h). A refused or weak peak is
-  // not held for a second opinion from another older submap:
-  // the candidates all overlap the newer submap, so they overlap each other too and see
-  // the same repeated structure, and an aliased peak against one recurs against the
-  // next. 0: off.
+  // A credible peak that moves the newer submap by more than half the window is kept
+  // only if a second search, centred on it, finds it the unique best too (loop_closure.h).
+  // A refused or weak peak is not retried against another older submap: the candidates
+  // all overlap the newer submap, so they overlap each other too and see the same
+  // repeated structure, and an aliased peak against one recurs against the next. 0: off.
   double loop_search_drift_m = 2.0;            // [0, 100]
   // Older submaps searched per level, largest overlaps first. A place revisited after a
   // long loop overlaps many older submaps (a corridor walked several times, rooms along

@@ -31,11 +31,10 @@
 // loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak scoring
 // loop_search_min_score that obstacle ICP confirms becomes a constraint unless it would
 // move the newer submap farther than the chain can have drifted
-// (loop_search_drift_m × √hops). A peak that moves it by more than half the window is
-// held until a later level's search agrees with it (search_second_opinion(): the
-// window proved it unique only on the side it covered); a peak is never held for a
-// second opinion from another older submap (sdp_options.h says why). A recorded
-// search constraint asks the owner to adjust at once
+// (loop_search_drift_m × √hops). A peak that moves it by more than half the window was
+// proved unique only on the side the window covered: the pair is searched again with
+// the window centred on the peak, and the peak is kept only if it is still the unique
+// best there (search_verdict()). A recorded search constraint asks the owner to adjust at once
 // (LoopSubmaps::on_verified_loop), so the next pair is judged against the corrected
 // frames.
 //
@@ -71,8 +70,8 @@ struct LoopClosureStats {
   std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
   std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints
   std::uint64_t loop_search_far = 0U;       // ... refused: would move their submap beyond loop_search_drift_m × √hops
-  std::uint64_t loop_search_held = 0U;      // ... moving their submap over half the window: held for a later level
-  std::uint64_t loop_search_confirmed = 0U; // of the held, those a later level's search agreed with (then recorded)
+  std::uint64_t loop_search_recentred = 0U; // ... moving their submap over half the window: searched again around the peak
+  std::uint64_t loop_search_recentred_closed = 0U;  // of those, confirmed by that search (then recorded)
 };
 
 // The submaps loop closure works on: for each level the graph holds, the submap of the
@@ -166,11 +165,10 @@ class LoopClosure {
   void search_pair(std::uint32_t older_level, std::uint32_t newer_level);
   void search_continue();
   void search_accept(const Record& r);
-  void search_second_opinion(const Record& r);
-  // Where r puts the corners of its newer submap's box in the global frame (via the
-  // older level's frame); false if either level has no placement.
-  bool corners_via(const Record& r, std::uint32_t level, double out[8]) const;
-  double corner_distance(const double a[8], const double b[8]) const;
+  void keep_verified(const Record& r);
+  CorrelativeOptions search_options(std::uint32_t older_level, std::uint32_t newer_level) const;
+  void search_verdict(const Record& r);
+  void recentre_verdict(const CorrelativeResult& c);
   bool centre_shift(const Record& r, double* dx_m, double* dy_m) const;
   bool moves_too_far(const Record& r) const;
   double drift_bound_m(std::uint32_t older_level, std::uint32_t newer_level) const;
@@ -198,9 +196,8 @@ class LoopClosure {
   std::uint32_t search_pair_older_ = 0U;
   std::uint32_t search_pair_newer_ = 0U;
   std::uint32_t* hops_ = nullptr;  // max_nodes (level_hops() scratch)
-  static constexpr std::uint32_t kHeldLoops = 8U;
-  Record held_[kHeldLoops] = {};  // peaks awaiting a later level's agreement, oldest first
-  std::uint32_t held_count_ = 0U;
+  bool recentring_ = false;  // the search in progress is centred on recentred_'s peak
+  Record recentred_{};
   std::uint32_t max_nodes_ = 0U;
 };
 
