@@ -1,7 +1,8 @@
 // CorrelativeMatcher (core/loops/correlative_matcher.h): the wide search behind loop closure.
 // A scene displaced by metres (far outside ICP's basin) is found within a grid cell and
 // a heading step; ICP from there lands on the truth; a corridor shifted along itself is
-// ambiguous, unrelated shapes are weak; bad input and a too-large grid are refused; the
+// ambiguous, unrelated shapes are weak; a partial overlap is judged on the points that
+// overlap; bad input and a too-large grid are refused; the
 // result is bit-identical across runs.
 #include <cmath>
 #include <cstring>
@@ -120,6 +121,44 @@ TEST(CorrelativeMatcher, finds_a_displacement_of_metres_and_icp_polishes_it) {
   DOUBLES_EQUAL(truth.y_m, polished.transform.y_m, 0.03);
   DOUBLES_EQUAL(truth.heading_rad, polished.transform.heading_rad, 0.005);
   delete icp;
+}
+
+// Two submaps overlap in part: the source saw the room and, beyond it, a square the
+// target never reached (as many points again, beyond the target's grid at every pose
+// of the window). The pose
+// is judged on the overlap, the room's points, and found as well as the room alone;
+// with fewer overlapping points than min_overlap_points it is weak.
+TEST(CorrelativeMatcher, a_source_that_saw_more_than_the_target_is_judged_on_the_overlap) {
+  const std::vector<Point2> target = room(0.1);
+  const Pose2 truth{1.2, -0.8, 0.1};
+  std::vector<Point2> seen = target;
+  // A 4 m square 4 m past the room's far wall, as many points as the room.
+  const double side_m = 4.0;
+  const std::size_t extra = target.size();
+  for (std::size_t k = 0; k < extra; ++k) {
+    const double t = 4.0 * side_m * static_cast<double>(k) / static_cast<double>(extra);
+    const double a = t < side_m ? t : (t < 2.0 * side_m ? side_m : (t < 3.0 * side_m ? 3.0 * side_m - t : 0.0));
+    const double b = t < side_m ? 0.0 : (t < 2.0 * side_m ? t - side_m : (t < 3.0 * side_m ? side_m : 4.0 * side_m - t));
+    seen.push_back(Point2{12.0 + a, 1.0 + b});
+  }
+  const std::vector<Point2> source = displaced(seen, truth, 0.02);
+  CorrelativeOptions o;
+  o.window_xy_m = 2.0;
+  o.window_theta_rad = 0.2;
+  o.min_score = 0.6;  // more than the share of the source the room is (one half)
+  o.min_overlap_points = static_cast<std::uint32_t>(target.size());
+  const auto n_t = static_cast<std::uint32_t>(target.size());
+  const auto n_s = static_cast<std::uint32_t>(source.size());
+  CorrelativeResult r = matcher->match(target.data(), n_t, source.data(), n_s, Pose2{}, o);
+  CHECK_TRUE(r.found());
+  CHECK_EQUAL(target.size(), r.overlap_points);
+  CHECK(r.score > 0.8);
+  DOUBLES_EQUAL(truth.x_m, r.transform.x_m, 0.15);
+  DOUBLES_EQUAL(truth.y_m, r.transform.y_m, 0.15);
+  DOUBLES_EQUAL(truth.heading_rad, r.transform.heading_rad, 0.02);
+  o.min_overlap_points = n_t + 1U;
+  r = matcher->match(target.data(), n_t, source.data(), n_s, Pose2{}, o);
+  CHECK_TRUE(r.status == CorrelativeResult::Status::kWeak);
 }
 
 TEST(CorrelativeMatcher, searches_around_the_guess) {

@@ -21,6 +21,7 @@ bool CorrelativeOptions::valid() const {
   return resolution_m >= 0.01 && resolution_m <= 1.0 && kernel_sigma_m >= 0.5 * resolution_m && kernel_sigma_m <= 2.0 &&
          coarse_cells >= 1U && coarse_cells <= 16U && window_xy_m >= 0.0 && window_xy_m <= 50.0 &&
          window_theta_rad >= 0.0 && window_theta_rad <= det::kPi && min_score > 0.0 && min_score <= 1.0 &&
+         min_overlap_points >= 1U &&
          max_ambiguity > 0.0 && max_ambiguity <= 1.0 && distinct_m >= 0.0 && distinct_rad >= 0.0 && candidates >= 1U &&
          candidates <= kMaxCandidates && window_xy_m / resolution_m <= 5000.0;
 }
@@ -63,6 +64,18 @@ std::uint32_t CorrelativeMatcher::score_at(const std::uint8_t* grid, std::int32_
     s += grid[static_cast<std::size_t>(y) * w_ + static_cast<std::size_t>(x)];
   }
   return s;
+}
+
+std::uint32_t CorrelativeMatcher::on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n) const {
+  const std::int32_t w = static_cast<std::int32_t>(w_);
+  const std::int32_t h = static_cast<std::int32_t>(h_);
+  std::uint32_t k = 0U;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const std::int32_t x = cells_[2U * i] + dx;
+    const std::int32_t y = cells_[2U * i + 1U] + dy;
+    if (x >= 0 && y >= 0 && x < w && y < h) ++k;
+  }
+  return k;
 }
 
 bool CorrelativeMatcher::begin(const Point2* target, std::uint32_t target_count, const Point2* source,
@@ -333,10 +346,13 @@ CorrelativeResult CorrelativeMatcher::finish() {
   const double tcx = gcx_ + static_cast<double>(pb.dx) * res_m;
   const double tcy = gcy_ + static_cast<double>(pb.dy) * res_m;
   res.transform = Pose2{tcx - (c * cx_ - s * cy_), tcy - (s * cx_ + c * cy_), normalize_angle_rad(th)};
-  const double full = 255.0 * static_cast<double>(source_count_);
+  // Judged on the overlap: the source points the best pose puts on the target's grid.
+  place(pb.heading);
+  res.overlap_points = on_grid(pb.dx, pb.dy, source_count_);
+  const double full = 255.0 * static_cast<double>(res.overlap_points > 0U ? res.overlap_points : 1U);
   res.score = static_cast<double>(pb.score) / full;
   res.second_score = static_cast<double>(second) / full;
-  if (res.score < o.min_score) {
+  if (res.overlap_points < o.min_overlap_points || res.score < o.min_score) {
     res.status = CorrelativeResult::Status::kWeak;
   } else if (static_cast<double>(second) >= o.max_ambiguity * static_cast<double>(pb.score)) {
     res.status = CorrelativeResult::Status::kAmbiguous;

@@ -291,6 +291,7 @@ CorrelativeOptions LoopClosure::search_options(std::uint32_t older_level, std::u
   co.window_xy_m = search_window_m(older_level, newer_level);
   co.window_theta_rad = options_.loop_search_window_rad;
   co.min_score = options_.loop_search_min_score;
+  co.min_overlap_points = options_.loop_min_pairs;  // what obstacle ICP needs to confirm a peak
   co.max_ambiguity = options_.loop_search_max_ambiguity;
   return co;
 }

@@ -147,7 +147,9 @@ struct SdpOptions {
   // submap is searched against up to loop_search_candidates older, non-adjacent
   // submaps whose boxes, grown by loop_search_window_m, overlap its own: exhaustively
   // within ±loop_search_window_m and ±loop_search_window_rad on their obstacle points;
-  // an unambiguous peak (mean likelihood >= loop_search_min_score, no distinct peak
+  // an unambiguous peak (mean likelihood >= loop_search_min_score over the newer
+  // submap's points that fall on the older one's grid, at least loop_min_pairs of
+  // them: two submaps overlap in part; no distinct peak
   // reaching loop_search_max_ambiguity × it) refined by obstacle ICP with the
   // loop_max_error_m / loop_min_pairs tests becomes a loop constraint. 0 = off.
   double loop_search_window_m = 0.0;           // [0, 20]

@@ -21,10 +21,15 @@
 //   - fine pass: the `candidates` best blocks, best bound first, every cell of the
 //     block scored exactly, while a block's bound can still beat max_ambiguity × the
 //     best exact score.
-// The best pose is returned if its mean value per source point (score / (255·n)) is at
-// least min_score and no distinct peak (farther than distinct_m or distinct_rad from
-// it) scores max_ambiguity × as much: a corridor, where any shift along the walls fits
-// as well, is ambiguous, not a loop.
+// The best pose is judged on its overlap: the source points it puts on the target's grid
+// (the target's bounding box grown by the kernel's reach). Two submaps of one building
+// overlap in part, and a source point beyond everything the target holds says nothing
+// for or against the pose; one inside the box that lands where the target has no wall
+// counts against it. The pose is returned if at least min_overlap_points lie on the
+// grid, their mean value (score / (255·overlap)) is at least min_score, and no distinct
+// peak (farther than distinct_m or distinct_rad from it) scores max_ambiguity × as
+// much: a corridor, where any shift along the walls fits as well, is ambiguous, not a
+// loop. The search itself ranks poses by their whole sum, so a larger overlap wins.
 //
 // Memory: two grids of max_grid_side² bytes, 2 × max_points int32 and max_steps²
 // uint32 block sums (max_steps = steps_for(the largest window)), carved
@@ -47,7 +52,8 @@ struct CorrelativeOptions {
   std::uint32_t coarse_cells = 4U;   // coarse translation step in cells, 1 .. 16
   double window_xy_m = 3.0;          // ± translation searched, [0, 50]
   double window_theta_rad = 0.35;    // ± heading searched, [0, pi]
-  double min_score = 0.45;           // mean value per source point of the best pose, (0, 1]
+  double min_score = 0.45;           // mean value per overlapping source point of the best pose, (0, 1]
+  std::uint32_t min_overlap_points = 3U;  // source points the best pose must put on the target's grid, >= 1
   double max_ambiguity = 0.9;        // a distinct peak scoring this × the best: ambiguous, (0, 1]
   double distinct_m = 0.5;           // peaks at least this far apart (or distinct_rad) are distinct
   double distinct_rad = 0.1;
@@ -69,8 +75,9 @@ struct CorrelativeResult {
   };
   Status status = Status::kInvalidInput;
   Pose2 transform;            // maps source coordinates into target coordinates
-  double score = 0.0;         // mean grid value per source point at transform, [0, 1]
-  double second_score = 0.0;  // best distinct peak seen, same unit
+  double score = 0.0;         // mean grid value per overlapping source point at transform, [0, 1]
+  double second_score = 0.0;  // best distinct peak seen: its sum over the same overlap count
+  std::uint32_t overlap_points = 0U;  // source points transform puts on the target's grid
   std::uint32_t poses_scored = 0U;
   bool found() const { return status == Status::kFound; }
 };
@@ -110,6 +117,7 @@ class CorrelativeMatcher {
     std::int32_t dy;
   };
   std::uint32_t score_at(const std::uint8_t* grid, std::int32_t dx, std::int32_t dy, std::uint32_t n) const;
+  std::uint32_t on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n) const;  // of the placed points
   double heading_of(std::uint32_t k) const;
   void place(std::uint32_t k);  // cells_ = source points at heading k, guess translation
 
