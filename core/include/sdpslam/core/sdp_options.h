@@ -134,9 +134,12 @@ struct SdpOptions {
   // translation information is (1/loop_sigma_xy_m²) × clamp(2 λ, loop_weak_direction_floor, 1)
   // along each eigenvector of M (eigenvalue λ): never more than the isotropic
   // constraint, and in the weak direction of a corridor little more than the floor.
-  // 0 = isotropic constraints.
+  // The floor only keeps the solve well posed (σ about 3 m along a bare corridor): a
+  // featureless corridor is matched along itself wherever the chain put it, so every
+  // such match repeats the chain's own drift, and many of them must not add up to a
+  // certainty the walls never gave. 0 = isotropic constraints.
   double loop_normal_radius_m = 0.4;       // [0, 2]
-  double loop_weak_direction_floor = 0.02;  // (0, 1]
+  double loop_weak_direction_floor = 0.001;  // [1e-4, 1]
   double loop_robust_chi = 3.0;
   std::uint32_t max_loop_constraints = 1024U;  // 1 .. capacity::kMaxLoopConstraints
   std::uint32_t graph_iterations = 5U;         // Gauss-Newton steps per adjustment, 1 .. 50
