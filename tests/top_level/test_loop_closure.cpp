@@ -138,6 +138,15 @@ std::vector<Point2> seen_from(const std::vector<Point2>& points, const Pose2& fr
 double distance_m(const Pose2& a, const Pose2& b) { return std::hypot(a.x_m - b.x_m, a.y_m - b.y_m); }
 double angle_rad(const Pose2& a, const Pose2& b) { return std::fabs(normalize_angle_rad(a.heading_rad - b.heading_rad)); }
 
+// A record the wide search made between these levels, on the true relative frame.
+void check_searched_record(const LoopClosure::Record& r, std::uint32_t older, std::uint32_t newer, const Pose2& truth) {
+  CHECK_EQUAL(older, r.older_level);
+  CHECK_EQUAL(newer, r.newer_level);
+  CHECK_TRUE(r.searched);
+  CHECK_TRUE(distance_m(r.z, truth) < 0.05);
+  CHECK_TRUE(angle_rad(r.z, truth) < 0.01);
+}
+
 }  // namespace
 
 TEST_GROUP(LoopClosure) {
@@ -157,12 +166,7 @@ TEST(LoopClosure, the_wide_search_finds_a_revisit_the_chain_placed_metres_off_an
   CHECK_TRUE(rig->init());
   rig->search_all();
   CHECK_EQUAL(1U, rig->loops.record_count());
-  const LoopClosure::Record& r = rig->loops.record(0);
-  CHECK_EQUAL(0U, r.older_level);
-  CHECK_EQUAL(2U, r.newer_level);
-  CHECK_TRUE(r.searched);
-  CHECK_TRUE(distance_m(r.z, truth2) < 0.05);
-  CHECK_TRUE(angle_rad(r.z, truth2) < 0.01);
+  check_searched_record(rig->loops.record(0), 0U, 2U, truth2);
   CHECK_EQUAL(1, o.verified);
   CHECK_TRUE(rig->stats.loop_searches >= 1U);
   CHECK_EQUAL(1U, rig->stats.loop_search_closed);
@@ -232,12 +236,7 @@ TEST(LoopClosure, a_large_correction_is_searched_again_around_its_peak) {
   CHECK_EQUAL(0U, rig->stats.loop_search_closed);  // each search has one outcome: recentred
   CHECK_EQUAL(1U, rig->loops.record_count());
   CHECK_EQUAL(1, rig->owner.verified);
-  const LoopClosure::Record& r = rig->loops.record(0);
-  CHECK_EQUAL(0U, r.older_level);
-  CHECK_EQUAL(3U, r.newer_level);
-  CHECK_TRUE(r.searched);
-  CHECK_TRUE(distance_m(r.z, truth3) < 0.05);
-  CHECK_TRUE(angle_rad(r.z, truth3) < 0.01);
+  check_searched_record(rig->loops.record(0), 0U, 3U, truth3);
 
   delete rig;
   rig = new Rig();

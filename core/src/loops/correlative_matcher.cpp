@@ -52,29 +52,29 @@ bool CorrelativeMatcher::init(std::uint32_t max_grid_side, std::uint32_t max_poi
   return true;
 }
 
-std::uint32_t CorrelativeMatcher::score_at(const std::uint8_t* grid, std::int32_t dx, std::int32_t dy,
-                                           std::uint32_t n) const {
+// Calls f(cell index) for each placed source point that the offset (dx, dy) puts on the grid.
+template <class F>
+void CorrelativeMatcher::visit_on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n, F&& f) const {
   const std::int32_t w = static_cast<std::int32_t>(w_);
   const std::int32_t h = static_cast<std::int32_t>(h_);
-  std::uint32_t s = 0U;
   for (std::uint32_t i = 0; i < n; ++i) {
     const std::int32_t x = cells_[2U * i] + dx;
     const std::int32_t y = cells_[2U * i + 1U] + dy;
     if (x < 0 || y < 0 || x >= w || y >= h) continue;
-    s += grid[static_cast<std::size_t>(y) * w_ + static_cast<std::size_t>(x)];
+    f(static_cast<std::size_t>(y) * w_ + static_cast<std::size_t>(x));
   }
+}
+
+std::uint32_t CorrelativeMatcher::score_at(const std::uint8_t* grid, std::int32_t dx, std::int32_t dy,
+                                           std::uint32_t n) const {
+  std::uint32_t s = 0U;
+  visit_on_grid(dx, dy, n, [&](std::size_t cell) { s += grid[cell]; });
   return s;
 }
 
 std::uint32_t CorrelativeMatcher::on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n) const {
-  const std::int32_t w = static_cast<std::int32_t>(w_);
-  const std::int32_t h = static_cast<std::int32_t>(h_);
   std::uint32_t k = 0U;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const std::int32_t x = cells_[2U * i] + dx;
-    const std::int32_t y = cells_[2U * i + 1U] + dy;
-    if (x >= 0 && y >= 0 && x < w && y < h) ++k;
-  }
+  visit_on_grid(dx, dy, n, [&](std::size_t) { ++k; });
   return k;
 }
 

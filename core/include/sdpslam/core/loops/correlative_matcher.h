@@ -118,6 +118,8 @@ class CorrelativeMatcher {
   };
   std::uint32_t score_at(const std::uint8_t* grid, std::int32_t dx, std::int32_t dy, std::uint32_t n) const;
   std::uint32_t on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n) const;  // of the placed points
+  template <class F>
+  void visit_on_grid(std::int32_t dx, std::int32_t dy, std::uint32_t n, F&& f) const;
   double heading_of(std::uint32_t k) const;
   void place(std::uint32_t k);  // cells_ = source points at heading k, guess translation
 
