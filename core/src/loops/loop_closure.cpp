@@ -378,10 +378,10 @@ void LoopClosure::search_verdict(const Record& r) {
 void LoopClosure::recentre_verdict(const CorrelativeResult& c) {
   recentring_ = false;
   if (!c.found()) return;
-  const CorrelativeOptions co;
+  const CorrelativeOptions co = search_options(recentred_.older_level, recentred_.newer_level);
   const Pose2 d = between(recentred_.z, c.transform);
-  if (d.x_m * d.x_m + d.y_m * d.y_m > co.distinct_m * co.distinct_m ||
-      det::detail::fabs(d.heading_rad) > co.distinct_rad) {
+  const double dth = d.heading_rad < 0.0 ? -d.heading_rad : d.heading_rad;
+  if (d.x_m * d.x_m + d.y_m * d.y_m > co.distinct_m * co.distinct_m || dth > co.distinct_rad) {
     return;
   }
   ++stats_->loop_search_recentred_closed;  // its search was counted recentred, not closed
