@@ -336,8 +336,7 @@ CorrelativeResult CorrelativeMatcher::finish() {
     const double ddy = static_cast<double>(peaks[i].dy - pb.dy) * res_m;
     const double dth =
         static_cast<double>(static_cast<std::int32_t>(peaks[i].heading) - static_cast<std::int32_t>(pb.heading)) * step_rad_;
-    const bool distinct = ddx * ddx + ddy * ddy > o.distinct_m * o.distinct_m || (dth < 0.0 ? -dth : dth) > o.distinct_rad;
-    if (distinct && peaks[i].score > second) second = peaks[i].score;
+    if (o.distinct(ddx, ddy, dth) && peaks[i].score > second) second = peaks[i].score;
   }
   // Pose: heading, then the translation that puts the centroid where the cells say.
   const double th = heading_of(pb.heading);

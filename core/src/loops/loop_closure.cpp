@@ -378,12 +378,8 @@ void LoopClosure::search_verdict(const Record& r) {
 void LoopClosure::recentre_verdict(const CorrelativeResult& c) {
   recentring_ = false;
   if (!c.found()) return;
-  const CorrelativeOptions co = search_options(recentred_.older_level, recentred_.newer_level);
   const Pose2 d = between(recentred_.z, c.transform);
-  const double dth = d.heading_rad < 0.0 ? -d.heading_rad : d.heading_rad;
-  if (d.x_m * d.x_m + d.y_m * d.y_m > co.distinct_m * co.distinct_m || dth > co.distinct_rad) {
-    return;
-  }
+  if (search_options(recentred_.older_level, recentred_.newer_level).distinct(d.x_m, d.y_m, d.heading_rad)) return;
   ++stats_->loop_search_recentred_closed;  // its search was counted recentred, not closed
   keep_verified(recentred_);
 }

@@ -61,6 +61,11 @@ struct CorrelativeOptions {
   static constexpr std::uint32_t kMaxCandidates = 64U;
   static constexpr std::uint32_t kMaxHeadings = 1024U;
   bool valid() const;
+  // Whether two poses this far apart (translation, heading difference) are distinct peaks.
+  bool distinct(double dx_m, double dy_m, double dheading_rad) const {
+    return dx_m * dx_m + dy_m * dy_m > distinct_m * distinct_m ||
+           (dheading_rad < 0.0 ? -dheading_rad : dheading_rad) > distinct_rad;
+  }
 };
 
 struct CorrelativeResult {
