@@ -30,7 +30,7 @@ as_root() {
 
 # Packages for the host build and tests; cross and fuzz extras for `test`.
 host_pkgs=(cmake ninja-build g++ pkg-config libcpputest-dev libpng-dev zlib1g-dev
-           libcli11-dev libinih-dev nlohmann-json3-dev libyaml-cpp-dev)
+           libcli11-dev libinih-dev nlohmann-json3-dev libyaml-cpp-dev libcairo2-dev)
 test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils
            dpkg-dev binutils lintian systemd)
 arm64_pkgs=(libcpputest-dev:arm64)

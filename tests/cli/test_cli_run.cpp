@@ -463,6 +463,57 @@ TEST(CliRun, localize_on_the_world_map_follows_the_true_path) {
   CHECK_TEXT(std::stod(r.out.substr(at + 5)) < 0.05, r.out.c_str());
 }
 
+// Width and height from a PNG's IHDR (0 x 0 when it is not a PNG).
+std::pair<unsigned, unsigned> png_size(const std::string& path) {
+  const std::string b = text_of(path);
+  if (b.size() < 24U || b.compare(1, 3, "PNG") != 0) return {0U, 0U};
+  auto be32 = [&b](std::size_t at) {
+    unsigned v = 0U;
+    for (std::size_t k = 0; k < 4U; ++k) v = (v << 8U) | static_cast<unsigned char>(b[at + k]);
+    return v;
+  };
+  return {be32(16U), be32(20U)};
+}
+
+// The figures of a run are drawn with text (tools/plot): the ICP error chart at its
+// chart size, the map with its title band and legend under it; `evaluate --plot` draws
+// the per-relation error (relations made here from the simulation's ground truth).
+TEST(CliRun, the_run_and_evaluate_draw_figures_with_text) {
+  Run r = run_cli("simulate --world paper --seed 1 --quiet --out " + dir + "/sim");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  r = run_cli("run " + dir + "/sim/sim.clf --quiet --out " + dir + "/run");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  const std::pair<unsigned, unsigned> chart = png_size(dir + "/run/icp_error.png");
+  LONGS_EQUAL(900U, chart.first);
+  LONGS_EQUAL(500U, chart.second);
+  const std::pair<unsigned, unsigned> map = png_size(dir + "/run/map.png");
+  CHECK(map.first >= 560U);  // room for the scale bar and the legend under the map
+  CHECK(map.second > 100U);
+  // Relations: each ground-truth pose with the one 20 poses later, in its frame.
+  std::vector<sdpslam::io::StampedPose> truth;
+  std::string error;
+  CHECK_TRUE_TEXT(sdpslam::io::read_trajectory(dir + "/sim/ground_truth.txt", &truth, &error), error.c_str());
+  std::string relations;
+  for (std::size_t k = 0; k + 20U < truth.size(); k += 50U) {
+    const sdpslam::Pose2 d = sdpslam::between(truth[k].pose, truth[k + 20U].pose);
+    char line[200];
+    std::snprintf(line, sizeof line, "%s %s %.6f %.6f 0 0 0 %.6f\n", sdpslam::io::format_stamp_us(truth[k].stamp_us).c_str(),
+                  sdpslam::io::format_stamp_us(truth[k + 20U].stamp_us).c_str(), d.x_m, d.y_m, d.heading_rad);
+    relations += line;
+  }
+  put("sim.relations", relations);
+  r = run_cli("evaluate --log " + dir + "/sim/sim.clf --relations " + dir + "/sim.relations --trajectory " + dir +
+              "/run/trajectory.txt --plot " + dir + "/relations.png");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  const std::pair<unsigned, unsigned> rel = png_size(dir + "/relations.png");
+  LONGS_EQUAL(900U, rel.first);
+  LONGS_EQUAL(500U, rel.second);
+  r = run_cli("evaluate --ground-truth " + dir + "/sim/ground_truth.txt --trajectory " + dir +
+              "/run/trajectory.txt --plot " + dir + "/ate.png");
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--plot needs --relations", r.out.c_str());
+}
+
 TEST(CliRun, localize_names_a_bad_start_and_a_missing_map) {
   const std::string log = log_with_bad_lines(0);
   Run r = run_cli("localize " + log + " --map " + dir + "/none.yaml --start 1,2 --out " + dir + "/loc");

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/figures.h"
 #include "sdpslam/io/map_image.h"
 #include "shared_data.h"
 
@@ -238,4 +239,55 @@ TEST(MapImage, png_bytes_are_deterministic) {
   const std::string a = slurp(dir + "/m.png");
   CHECK_TRUE(sdpslam::io::write_map_png(dir + "/m.png", small_map(), {}, &error));
   CHECK(a == slurp(dir + "/m.png"));
+}
+
+// The plain painter (figures.h), for builds without a drawing library: a chart as its
+// series on two axes, without text: the first line series in the path colour, points in
+// the point colour, a band in grey; a map figure as write_map_png() draws it.
+TEST(MapImage, the_plain_painter_draws_a_chart_and_a_map_without_text) {
+  sdpslam::io::Chart chart;
+  sdpslam::io::ChartSeries band;
+  band.style = sdpslam::io::ChartSeries::Style::kBand;
+  sdpslam::io::ChartSeries line;
+  sdpslam::io::ChartSeries dots;
+  dots.style = sdpslam::io::ChartSeries::Style::kPoints;
+  for (int k = 0; k <= 50; ++k) {
+    band.x.push_back(k);
+    band.y.push_back(1.0);
+    band.y_high.push_back(3.0);
+    line.x.push_back(k);
+    line.y.push_back(2.0);
+    dots.x.push_back(k);
+    dots.y.push_back(4.0);
+  }
+  chart.series = {band, line, dots};
+  CHECK_TRUE(sdpslam::io::chart_has_data(chart));
+  const sdpslam::io::Painter plain = sdpslam::io::plain_painter();
+  std::string error;
+  CHECK_TRUE_TEXT(plain.chart(dir + "/t.png", chart, &error), error.c_str());
+  const DecodedPng d = decode(dir + "/t.png");
+  LONGS_EQUAL(640, d.width);
+  LONGS_EQUAL(320, d.height);
+  LONGS_EQUAL(3, d.channels);
+  int red = 0, orange = 0, grey = 0;
+  for (std::size_t i = 0; i + 2 < d.px.size(); i += 3) {
+    const int r = d.px[i], g = d.px[i + 1], b = d.px[i + 2];
+    red += (r == 220 && g == 20 && b == 20) ? 1 : 0;
+    orange += (r == 255 && g == 140 && b == 0) ? 1 : 0;
+    grey += (r == 128 && g == 128 && b == 128) ? 1 : 0;
+  }
+  CHECK(red > 500);    // the line across the plot
+  CHECK(orange >= 40); // one pixel per point
+  CHECK(grey > 1000);  // the band
+  const OccupancyImage m = small_map();
+  sdpslam::io::MapFigure f;
+  f.map = &m;
+  CHECK_TRUE_TEXT(plain.map(dir + "/m.png", f, &error), error.c_str());
+  CHECK(slurp(dir + "/m.png") == [&] {
+    CHECK_TRUE(sdpslam::io::write_map_png(dir + "/far.png", m, {}, &error));
+    return slurp(dir + "/far.png");
+  }());
+  f.map = nullptr;
+  CHECK_FALSE(plain.map(dir + "/m.png", f, &error));
+  STRCMP_CONTAINS("m.png", error.c_str());
 }

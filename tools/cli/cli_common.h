@@ -9,6 +9,8 @@
 #include <functional>
 #include <string>
 
+#include "sdpslam/io/figures.h"
+
 namespace sdpslam::cli {
 
 // Exit codes: scripts can tell bad input from a fault of the program.
@@ -27,6 +29,10 @@ enum ExitCode : int {
 // not a failed write). A refused value exits kExitUsage with the option's name.
 CLI::Validator whole_number(std::uint64_t max);
 CLI::Validator non_empty();
+
+// How the commands draw their figures: plot::painter() (titles, axes, legends, scale
+// bars; tools/plot), or io::plain_painter() in a build without cairo.
+io::Painter figure_painter();
 
 // Size of a file in KiB (0 when it cannot be read), a progress total.
 std::uint64_t file_size_kib(const std::string& path);

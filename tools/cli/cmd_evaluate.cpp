@@ -58,6 +58,7 @@ struct EvaluateArgs {
   std::string map_path;
   std::string loops_path;
   std::string json_path;
+  std::string plot_path;
   bool odometry = false;
   double rpe_m = 10.0;
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
@@ -102,6 +103,35 @@ int read_trajectory_file(const std::string& path, std::vector<io::StampedPose>* 
 }
 
 // ---- the evaluations --------------------------------------------------------------------
+
+// Each used relation's translational error at the time its first stamp is from the
+// first relation's, and their mean.
+io::Chart relations_chart(const eval::RelationsResult& res, const std::string& source) {
+  io::Chart chart;
+  const std::size_t slash = source.find_last_of('/');
+  chart.title = "Relations metric: translational error per relation (" +
+                (slash == std::string::npos ? source : source.substr(slash + 1U)) + ")";
+  chart.x_label = "relation start, time since the first relation (s)";
+  chart.y_label = "translational error (m)";
+  io::ChartSeries each = io::ChartSeries::named("one relation", io::Rgb8{40, 90, 180}, io::ChartSeries::Style::kPoints);
+  char label[96];
+  std::snprintf(label, sizeof label, "mean of %zu: %.4f m", res.per_relation.size(), res.translation_m.mean);
+  io::ChartSeries mean = io::ChartSeries::named(label, io::Rgb8{200, 30, 30});
+  std::int64_t t0_us = res.per_relation.empty() ? 0 : res.per_relation.front().relation.t1_us;
+  for (const eval::RelationResult& r : res.per_relation) t0_us = std::min(t0_us, r.relation.t1_us);
+  double t_end_s = 0.0;
+  for (const eval::RelationResult& r : res.per_relation) {
+    const double t_s = static_cast<double>(r.relation.t1_us - t0_us) * 1e-6;
+    each.x.push_back(t_s);
+    each.y.push_back(r.translation_error_m);
+    t_end_s = std::max(t_end_s, t_s);
+  }
+  mean.x = {0.0, t_end_s};
+  mean.y = {res.translation_m.mean, res.translation_m.mean};
+  chart.series.push_back(each);
+  chart.series.push_back(mean);
+  return chart;
+}
 
 int run_relations(const EvaluateArgs& a, io::Json* json) {
   std::vector<eval::Relation> relations;
@@ -181,6 +211,13 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
     std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
                  a.log_path.c_str());
     return kExitBadInput;
+  }
+  if (!a.plot_path.empty()) {
+    std::string plot_error;
+    if (!figure_painter().chart(a.plot_path, relations_chart(res, source), &plot_error)) {
+      std::fprintf(stderr, "sdpslam evaluate: %s\n", plot_error.c_str());
+      return kExitIo;
+    }
   }
   return kExitOk;
 }
@@ -340,6 +377,10 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --rpe-m must be a distance in metres, 0 .. 1e6 (0: not measured)\n");
     return kExitUsage;
   }
+  if (!a.plot_path.empty() && !want_relations) {
+    std::fprintf(stderr, "sdpslam evaluate: --plot needs --relations\n");
+    return kExitUsage;
+  }
   if (a.tolerance_us < 0) {
     std::fprintf(stderr, "sdpslam evaluate: --stamp-tolerance-us must not be negative\n");
     return kExitUsage;
@@ -385,6 +426,8 @@ std::function<int()> setup_evaluate(CLI::App& app) {
   app.add_option("--loops", args->loops_path,
                  "with --ground-truth: check the loop constraints of a run (its loops.tsv) against it");
   app.add_option("--json", args->json_path, "also write the figures to this JSON file");
+  app.add_option("--plot", args->plot_path,
+                 "with --relations: draw each relation's translational error over time into this PNG file");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
                  "stamps closer than this name the same scan when not equal (default 1000)");
   return [args] { return run_evaluate(*args); };

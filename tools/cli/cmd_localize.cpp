@@ -35,6 +35,7 @@ int run_localize_command(const LocalizeArgs& a) {
     }
     o.have_start = true;
   }
+  o.painter = figure_painter();
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   o.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::LocalizeSummary s;

@@ -133,6 +133,7 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
     return rc;
   }
   ro.seed = a.seed;
+  ro.painter = figure_painter();
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::SdpRunSummary s;
@@ -166,6 +167,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
     return rc;
   }
   ro.seed = a.seed;
+  ro.painter = figure_painter();
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::RunSummary summary;

@@ -99,7 +99,7 @@ int run_simulate(const SimulateArgs& args) {
   sim::SimulationOutputs out;
   const sim::OutputStatus status = sim::simulate_to_directory(world, world_name, route, options,
                                                               args.map_resolution_m, args.out_dir, &out, &error,
-                                                              on_progress);
+                                                              on_progress, figure_painter());
   progress.finish();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (status == sim::OutputStatus::kBadOptions) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/figures.h"
 
 namespace sdpslam::io {
 namespace {
@@ -76,13 +77,11 @@ std::vector<std::uint8_t> grey_pixels(const OccupancyImage& map, bool negate) {
 
 // ---- trajectory overlay ----------------------------------------------------------------
 
-struct Rgb {
-  std::uint8_t r, g, b;
-};
-constexpr Rgb kPathColour{220, 20, 20};
-constexpr Rgb kStartColour{0, 170, 0};
-constexpr Rgb kEndColour{20, 40, 230};
-constexpr Rgb kPointColour{255, 140, 0};
+using Rgb = Rgb8;
+constexpr Rgb kPathColour = kFigurePathColour;
+constexpr Rgb kStartColour = kFigureStartColour;
+constexpr Rgb kEndColour = kFigureEndColour;
+constexpr Rgb kPointColour = kFigurePointColour;
 constexpr int kMarkerHalfSize = 2;  // markers are 5 x 5 pixel squares
 
 class RgbCanvas {

@@ -82,7 +82,7 @@ OutputFiles output_files(const std::string& dir) {
 OutputStatus simulate_to_directory(const World& world, const std::string& world_name, const Route& route,
                                    const SimulationOptions& options, double map_resolution_m,
                                    const std::string& dir, SimulationOutputs* outputs, std::string* error,
-                                   const std::function<void(double, double)>& progress) {
+                                   const std::function<void(double, double)>& progress, const io::Painter& painter) {
   *outputs = SimulationOutputs{};
   if (!validate_simulation_options(options, error)) return OutputStatus::kBadOptions;
   if (route.waypoints.size() < 2) {
@@ -116,7 +116,12 @@ OutputStatus simulate_to_directory(const World& world, const std::string& world_
   raster.free_seed_y_m = route.waypoints[0].y_m;
   const io::OccupancyImage map = rasterize_world(world, raster);
   if (!io::write_map_pgm_yaml(files.map_stem, map, io::MapWriteOptions{}, error)) return OutputStatus::kIoError;
-  if (!io::write_map_png(files.map_png, map, outputs->ground_truth, error)) return OutputStatus::kIoError;
+  io::MapFigure figure;
+  figure.title = "Simulated world '" + world_name + "' and the ground-truth path";
+  figure.map = &map;
+  figure.path = outputs->ground_truth;
+  figure.path_label = "ground truth";
+  if (!painter.map(files.map_png, figure, error)) return OutputStatus::kIoError;
   if (!set.commit(error)) return OutputStatus::kIoError;
   return OutputStatus::kOk;
 }

@@ -138,7 +138,13 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
 
   if (!write_trajectories(outputs.staging_dir(), trajectory, error)) return LocalizeStatus::kIoError;
   const std::vector<Pose2> final_set(mcl->particles(), mcl->particles() + mcl->particle_count());
-  if (!io::write_map_png(outputs.path("map.png"), image, trajectory, final_set, error)) return LocalizeStatus::kIoError;
+  io::MapFigure figure;
+  figure.title = options.have_start ? "Localization on the map (from the given start)" : "Localization on the map (global start)";
+  figure.map = &image;
+  figure.path = trajectory;
+  figure.points = final_set;
+  figure.points_label = "final particles";
+  if (!options.painter.map(outputs.path("map.png"), figure, error)) return LocalizeStatus::kIoError;
   std::string particles = "# x_m y_m theta_rad: the final particle set\n";
   for (std::uint32_t i = 0; i < mcl->particle_count(); ++i) {
     const Pose2& p = mcl->particles()[i];

@@ -99,7 +99,9 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   const DpMap& map = filter->map();
   io::OccupancyImage image;
   const std::uint32_t known_cells = best_map_image(*filter, &image);
-  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error)) return RunStatus::kIoError;
+  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error, &options.painter)) {
+    return RunStatus::kIoError;
+  }
 
   // stats.json: deterministic fields first, timing apart.
   const AncestryTree& tree = filter->tree();

@@ -104,46 +104,26 @@ using detail::percentile;
 using detail::rusage_cpu_s;
 using detail::thread_cpu_ms;
 
-// Line plot of the per-round ICP error (mean, with a ±std band), rasterised on an
-// occupancy canvas: white background, black axes, grey band, the mean drawn in colour
-// by the map PNG writer's trajectory overlay.
-bool write_error_plot(const std::string& path, const std::vector<Row>& rows, std::int64_t t0_us, std::int64_t t1_us,
-                      std::string* error) {
-  constexpr std::uint32_t kW = 640U, kH = 320U, kMargin = 20U;
-  io::OccupancyImage img;
-  img.width = kW;
-  img.height = kH;
-  img.resolution_m = 1.0;
-  img.occupancy.assign(static_cast<std::size_t>(kW) * kH, 0.0F);
-  auto put = [&img](std::int64_t x, std::int64_t y, float v) {
-    if (x >= 0 && y >= 0 && x < kW && y < kH) img.occupancy[static_cast<std::size_t>(y) * kW + static_cast<std::size_t>(x)] = v;
-  };
-  for (std::uint32_t x = kMargin; x < kW - kMargin / 2U; ++x) put(x, kMargin, 1.0F);
-  for (std::uint32_t y = kMargin; y < kH - kMargin / 2U; ++y) put(kMargin, y, 1.0F);
-  double emax = 0.0;
-  for (const Row& r : rows) emax = std::max(emax, r.mean_m + r.std_m);
-  if (!(emax > 0.0)) emax = 1.0;
-  // Tick every 0.5 m (or 0.1 m for small errors) on the y axis.
-  const double tick = emax > 2.0 ? 0.5 : 0.1;
-  const double span_t = std::max(1.0, static_cast<double>(t1_us - t0_us) * 1e-6);
-  const double sx = static_cast<double>(kW - 2U * kMargin) / span_t;
-  const double sy = static_cast<double>(kH - 2U * kMargin) / emax;
-  for (double e = tick; e <= emax; e += tick) {
-    const auto y = static_cast<std::int64_t>(kMargin + e * sy);
-    for (std::int64_t x = kMargin - 4; x < static_cast<std::int64_t>(kMargin); ++x) put(x, y, 1.0F);
-  }
-  std::vector<io::StampedPose> line;
+// The per-round ICP error over time: its mean, with a band of ± one standard deviation.
+io::Chart error_chart(const std::vector<Row>& rows, std::int64_t t0_us) {
+  io::Chart chart;
+  chart.title = "Top-level ICP error of the chosen segments";
+  chart.x_label = "time since the first scan (s)";
+  chart.y_label = "mean nearest-neighbour distance (m)";
+  io::ChartSeries band =
+      io::ChartSeries::named("mean ± 1 standard deviation", io::Rgb8{70, 110, 200}, io::ChartSeries::Style::kBand);
+  io::ChartSeries mean = io::ChartSeries::named("mean", io::Rgb8{20, 50, 150});
   for (const Row& r : rows) {
-    const double x = kMargin + static_cast<double>(r.stamp_us - t0_us) * 1e-6 * sx;
-    const auto y0 = static_cast<std::int64_t>(kMargin + std::max(0.0, r.mean_m - r.std_m) * sy);
-    const auto y1 = static_cast<std::int64_t>(kMargin + (r.mean_m + r.std_m) * sy);
-    for (std::int64_t y = y0; y <= y1; ++y) {
-      put(static_cast<std::int64_t>(x), y, 0.5F);
-      put(static_cast<std::int64_t>(x) + 1, y, 0.5F);
-    }
-    line.push_back(io::StampedPose{r.stamp_us, Pose2{x + 0.5, kMargin + r.mean_m * sy + 0.5, 0.0}});
+    const double t_s = static_cast<double>(r.stamp_us - t0_us) * 1e-6;
+    band.x.push_back(t_s);
+    band.y.push_back(std::max(0.0, r.mean_m - r.std_m));
+    band.y_high.push_back(r.mean_m + r.std_m);
+    mean.x.push_back(t_s);
+    mean.y.push_back(r.mean_m);
   }
-  return io::write_map_png(path, img, line, error);
+  chart.series.push_back(band);
+  chart.series.push_back(mean);
+  return chart;
 }
 
 }  // namespace
@@ -378,7 +358,9 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
 
   io::OccupancyImage image;
   const std::uint32_t known_cells = sdp_global_map_image(*slam, &image);
-  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error)) return SdpRunStatus::kIoError;
+  if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error, &options.painter)) {
+    return SdpRunStatus::kIoError;
+  }
   std::string csv = "stamp_s,mean_m,std_m,samples\n";
   for (const Row& r : rows.rows) {
     char line[128];
@@ -388,7 +370,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   }
   if (!io::write_file_atomic(outputs.path("icp_error.csv"), csv, error)) return SdpRunStatus::kIoError;
   if (!io::write_file_atomic(outputs.path("loops.tsv"), sdp_loops_tsv(*slam), error)) return SdpRunStatus::kIoError;
-  if (!write_error_plot(outputs.path("icp_error.png"), rows.rows, scans.front().stamp_us, scans.back().stamp_us, error)) {
+  const io::Chart chart = error_chart(rows.rows, scans.front().stamp_us);
+  if (io::chart_has_data(chart) && !options.painter.chart(outputs.path("icp_error.png"), chart, error)) {
     return SdpRunStatus::kIoError;
   }
 

@@ -75,11 +75,16 @@ io::MapWriteOptions slam_map_thresholds() {
 }
 
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
-                              const io::OccupancyImage& image, std::string* error) {
+                              const io::OccupancyImage& image, std::string* error, const io::Painter* painter) {
   if (!write_trajectories(out_dir, trajectory, error)) return false;
   if (image.width > 0U) {
     if (!io::write_map_pgm_yaml(out_dir + "/map", image, slam_map_thresholds(), error)) return false;
-    if (!io::write_map_png(out_dir + "/map.png", image, trajectory, error)) return false;
+    io::MapFigure figure;
+    figure.title = "Map and path";
+    figure.map = &image;
+    figure.path = trajectory;
+    const io::Painter plain = io::plain_painter();
+    if (!(painter != nullptr ? *painter : plain).map(out_dir + "/map.png", figure, error)) return false;
   }
   return true;
 }

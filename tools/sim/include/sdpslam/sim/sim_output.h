@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "sdpslam/io/figures.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/sim/simulator.h"
 #include "sdpslam/sim/world_raster.h"
@@ -43,7 +44,8 @@ struct SimulationOutputs {
 OutputStatus simulate_to_directory(const World& world, const std::string& world_name, const Route& route,
                                    const SimulationOptions& options, double map_resolution_m,
                                    const std::string& dir, SimulationOutputs* outputs, std::string* error,
-                                   const std::function<void(double, double)>& progress = {});
+                                   const std::function<void(double, double)>& progress = {},
+                                   const io::Painter& painter = io::plain_painter());
 
 // Position RMSE between two trajectories matched by index (same stamps), without
 // alignment. Returns 0 for empty input; uses the shorter length.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "sdpslam/core/localization/monte_carlo_localizer.h"
+#include "sdpslam/io/figures.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/log_reader.h"
 
@@ -33,6 +34,8 @@ struct LocalizeRunOptions {
   double start_sigma_theta_rad = 0.15;
   std::uint64_t skip_scans = 0U;     // scans of the log left out before the first
   std::function<void(std::uint64_t input_bytes)> progress;
+  // Draws map.png: the path and the final particles on the map (figures.h).
+  io::Painter painter = io::plain_painter();
 };
 
 struct LocalizeSummary {

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "sdpslam/io/figures.h"
 #include "sdpslam/slam/config_ini.h"
 
 namespace sdpslam::slam {
@@ -31,6 +32,8 @@ struct RunOptions {
   // Called after every scan with the bytes of the log read so far (compressed bytes for
   // .gz; io::LogReader::input_offset()), for a progress display; may be empty.
   std::function<void(std::uint64_t input_bytes)> progress;
+  // Draws map.png (figures.h; the sdpslam CLI: plot::painter()).
+  io::Painter painter = io::plain_painter();
 };
 
 struct RunSummary {

@@ -28,6 +28,7 @@
 
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/sdp_profile.h"
+#include "sdpslam/io/figures.h"
 #include "sdpslam/slam/config_ini.h"
 
 namespace sdpslam::slam {
@@ -42,6 +43,8 @@ struct SdpRunOptions {
   // Called after every scan with the bytes of the log read so far (compressed bytes for
   // .gz; io::LogReader::input_offset()), for a progress display; may be empty.
   std::function<void(std::uint64_t input_bytes)> progress;
+  // Draws map.png and icp_error.png (figures.h; the sdpslam CLI: plot::painter()).
+  io::Painter painter = io::plain_painter();
 };
 
 struct SdpRunSummary {

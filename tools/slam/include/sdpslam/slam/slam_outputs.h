@@ -20,6 +20,7 @@
 
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/io/figures.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/trajectory_io.h"
@@ -64,9 +65,10 @@ io::MapWriteOptions slam_map_thresholds();
 // Writes the trajectories (write_trajectories) and, when the image is not empty,
 // out_dir/map.pgm, map.yaml (slam_map_thresholds()) and map.png. False (with `error`) at
 // the first write that failed; the files already written and the previous versions of the
-// others stay complete.
+// others stay complete. map.png is drawn by `painter` (figures.h; null: the plain one).
 bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::StampedPose>& trajectory,
-                              const io::OccupancyImage& image, std::string* error);
+                              const io::OccupancyImage& image, std::string* error,
+                              const io::Painter* painter = nullptr);
 
 // ---- SDP-SLAM ------------------------------------------------------------------------
 
