@@ -1,5 +1,7 @@
 #include "sdpslam/drivers/canopen_encoder_pair.h"
 
+#include "sdpslam/drivers/internal/encoder_pair_poll.h"
+
 namespace sdpslam::drivers {
 
 CanOpenOptionsError validate(const CanOpenEncoderOptions& o) {
@@ -135,46 +137,12 @@ void CanOpenEncoderPair::handle(const hal::CanFrame& f, std::int64_t now_us) {
 int CanOpenEncoderPair::update() {
   if (!options_ok_) return -1;
   if (started_ && nmt_pending_ != 0) start();
-  int new_samples = 0;
-  int result = 0;
-  std::int64_t newest_frame_stamp_us = 0;
-  for (int i = 0; i < options_.max_frames_per_update; ++i) {
-    hal::CanFrame f;
-    const int r = bus_.receive(f);
-    if (r == 0) break;
-    if (r < 0) {
-      stats_.rx_errors++;
-      if (bus_.state() == hal::CanBusState::kDown) {
-        result = -1;
-        break;
-      }
-      continue;  // e.g. one bad datagram: keep reading
-    }
-    const auto before = stats_.positions[0] + stats_.positions[1];
-    if (f.stamp_us > newest_frame_stamp_us) newest_frame_stamp_us = f.stamp_us;
-    handle(f, clock_.now_us());
-    new_samples += static_cast<int>(stats_.positions[0] + stats_.positions[1] - before);
-  }
-  const std::int64_t now = clock_.now_us();
-  produce_sync(now);
-  // Frames received long before this read (a backlog) are judged at their own stamps.
-  const bool backlog = newest_frame_stamp_us > 0 && now - newest_frame_stamp_us > options_.position_timeout_us;
-  for (auto& w : wheels_) {
-    if (backlog) {
-      w.evaluate_at_stamp(newest_frame_stamp_us, options_.position_timeout_us);
-    } else if (w.evaluate(now, options_.position_timeout_us, options_.heartbeat_timeout_us,
-                          supervision_start_us_)) {
-      stats_.heartbeat_timeouts++;
-    }
-  }
-  return result < 0 ? result : new_samples;
+  return internal::poll_encoder_pair(
+      bus_, clock_, options_, supervision_start_us_, wheels_, stats_,
+      [this](const hal::CanFrame& f, std::int64_t now_us) { handle(f, now_us); },
+      [this](std::int64_t now_us) { produce_sync(now_us); });
 }
 
-hal::WheelEncoderSample CanOpenEncoderPair::latest() const {
-  hal::WheelEncoderSample s;
-  s.left = wheels_[0].ticks;
-  s.right = wheels_[1].ticks;
-  return s;
-}
+hal::WheelEncoderSample CanOpenEncoderPair::latest() const { return internal::pair_sample(wheels_); }
 
 }  // namespace sdpslam::drivers
