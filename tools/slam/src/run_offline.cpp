@@ -161,19 +161,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   if (!io::write_file_atomic(outputs.path("stats.json"), io::json_text(js), error)) return RunStatus::kIoError;
   if (!outputs.commit(error)) return RunStatus::kIoError;
 
-  if (summary != nullptr) {
-    summary->scans = scans.size();
-    summary->processed = st.processed;
-    summary->log_error_count = reader.error_count();
-    summary->log_errors = reader.errors();
-    summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
-    summary->odometry_jumps_removed = reader.odometry_jumps_removed();
-    summary->scans_stamped_backwards = reader.scans_stamped_backwards();
-    if (reader.scans_stamped_backwards() > 0U) {
-      summary->first_backwards_at = log_path + ":" + std::to_string(reader.first_backwards_line());
-    }
-    summary->wall_time_s = wall_s;
-  }
+  if (summary != nullptr) *summary = run_summary(reader, log_path, scans.size(), st.processed, wall_s);
   return RunStatus::kOk;
 }
 

@@ -420,18 +420,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   if (!outputs.commit(error)) return SdpRunStatus::kIoError;
 
   if (summary != nullptr) {
-    summary->scans = scans.size();
-    summary->processed = bs.processed;
+    static_cast<RunSummary&>(*summary) = run_summary(reader, log_path, scans.size(), bs.processed, wall_s);
     summary->segments = st.segments;
-    summary->log_error_count = reader.error_count();
-    summary->log_errors = reader.errors();
-    summary->odometry_reversals_repaired = reader.odometry_reversals_repaired();
-    summary->odometry_jumps_removed = reader.odometry_jumps_removed();
-    summary->scans_stamped_backwards = reader.scans_stamped_backwards();
-    if (reader.scans_stamped_backwards() > 0U) {
-      summary->first_backwards_at = log_path + ":" + std::to_string(reader.first_backwards_line());
-    }
-    summary->wall_time_s = wall_s;
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();
     summary->icp_error_samples = st.error_samples;

@@ -20,6 +20,7 @@
 
 #include "sdpslam/io/figures.h"
 #include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/run_summary.h"
 
 namespace sdpslam::slam {
 
@@ -34,18 +35,6 @@ struct RunOptions {
   std::function<void(std::uint64_t input_bytes)> progress;
   // Draws map.png (figures.h; the sdpslam CLI: plot::painter()).
   io::Painter painter = io::plain_painter();
-};
-
-struct RunSummary {
-  std::uint64_t scans = 0U;
-  std::uint64_t processed = 0U;
-  std::size_t log_error_count = 0U;
-  std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
-  std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
-  std::size_t odometry_jumps_removed = 0U;       // io::LogReader::odometry_jumps_removed()
-  std::size_t scans_stamped_backwards = 0U;      // io::LogReader::scans_stamped_backwards()
-  std::string first_backwards_at;                // "file:line" of the first of them
-  double wall_time_s = 0.0;
 };
 
 enum class RunStatus { kOk, kBadInput, kIoError, kInternal };

@@ -30,6 +30,7 @@
 #include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/io/figures.h"
 #include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/run_summary.h"
 
 namespace sdpslam::slam {
 
@@ -47,17 +48,8 @@ struct SdpRunOptions {
   io::Painter painter = io::plain_painter();
 };
 
-struct SdpRunSummary {
-  std::uint64_t scans = 0U;
-  std::uint64_t processed = 0U;
+struct SdpRunSummary : RunSummary {
   std::uint64_t segments = 0U;
-  std::size_t log_error_count = 0U;
-  std::vector<io::LogError> log_errors;  // the first skipped lines (io::LogReader::errors())
-  std::size_t odometry_reversals_repaired = 0U;  // io::LogReader::odometry_reversals_repaired()
-  std::size_t odometry_jumps_removed = 0U;       // io::LogReader::odometry_jumps_removed()
-  std::size_t scans_stamped_backwards = 0U;      // io::LogReader::scans_stamped_backwards()
-  std::string first_backwards_at;                // "file:line" of the first of them
-  double wall_time_s = 0.0;
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
   std::uint64_t icp_error_samples = 0U;
