@@ -192,20 +192,18 @@ double SegmentGraph::pair_probability(std::uint32_t level, std::uint32_t a, std:
   return weight(*target) / total;
 }
 
+template <class LevelsLive>
+PgsStatus SegmentGraph::check_sampling(double u, LevelsLive&& levels_live) const {
+  if (!initialised()) return refuse(PgsStatus::kNotInitialised);
+  if (!unit_interval(u)) return refuse(PgsStatus::kBadArgument);
+  if (!levels_live()) return refuse(PgsStatus::kNoLevel);
+  return PgsStatus::kOk;
+}
+
 PgsPairPick SegmentGraph::sample_pair(std::uint32_t level, double u) const {
   PgsPairPick r;
-  if (!initialised()) {
-    r.status = refuse(PgsStatus::kNotInitialised);
-    return r;
-  }
-  if (!unit_interval(u)) {
-    r.status = refuse(PgsStatus::kBadArgument);
-    return r;
-  }
-  if (!is_live(level) || !is_live(level + 1U)) {
-    r.status = refuse(PgsStatus::kNoLevel);
-    return r;
-  }
+  r.status = check_sampling(u, [&] { return is_live(level) && is_live(level + 1U); });
+  if (r.status != PgsStatus::kOk) return r;
   const std::uint32_t nb = node_count(level + 1U);
   const std::uint32_t flat = pick(node_count(level) * nb, u, [&](std::uint32_t k) {
     return weight(*edge_ptr(level, k / nb, k % nb));
@@ -218,18 +216,8 @@ PgsPairPick SegmentGraph::sample_pair(std::uint32_t level, double u) const {
 
 PgsPick SegmentGraph::sample_next(std::uint32_t level, std::uint32_t a, double u) const {
   PgsPick r;
-  if (!initialised()) {
-    r.status = refuse(PgsStatus::kNotInitialised);
-    return r;
-  }
-  if (!unit_interval(u)) {
-    r.status = refuse(PgsStatus::kBadArgument);
-    return r;
-  }
-  if (!is_live(level) || !is_live(level + 1U)) {
-    r.status = refuse(PgsStatus::kNoLevel);
-    return r;
-  }
+  r.status = check_sampling(u, [&] { return is_live(level) && is_live(level + 1U); });
+  if (r.status != PgsStatus::kOk) return r;
   if (a >= node_count(level)) {
     r.status = refuse(PgsStatus::kBadNode);
     return r;
@@ -241,18 +229,8 @@ PgsPick SegmentGraph::sample_next(std::uint32_t level, std::uint32_t a, double u
 
 PgsPick SegmentGraph::sample_previous(std::uint32_t level, std::uint32_t b, double u) const {
   PgsPick r;
-  if (!initialised()) {
-    r.status = refuse(PgsStatus::kNotInitialised);
-    return r;
-  }
-  if (!unit_interval(u)) {
-    r.status = refuse(PgsStatus::kBadArgument);
-    return r;
-  }
-  if (level == 0U || !is_live(level) || !is_live(level - 1U)) {
-    r.status = refuse(PgsStatus::kNoLevel);
-    return r;
-  }
+  r.status = check_sampling(u, [&] { return level != 0U && is_live(level) && is_live(level - 1U); });
+  if (r.status != PgsStatus::kOk) return r;
   if (b >= node_count(level)) {
     r.status = refuse(PgsStatus::kBadNode);
     return r;
@@ -265,18 +243,8 @@ PgsPick SegmentGraph::sample_previous(std::uint32_t level, std::uint32_t b, doub
 
 PgsPick SegmentGraph::sample_first(double u) const {
   PgsPick r;
-  if (!initialised()) {
-    r.status = refuse(PgsStatus::kNotInitialised);
-    return r;
-  }
-  if (!unit_interval(u)) {
-    r.status = refuse(PgsStatus::kBadArgument);
-    return r;
-  }
-  if (live_count_ == 0U) {
-    r.status = refuse(PgsStatus::kNoLevel);
-    return r;
-  }
+  r.status = check_sampling(u, [&] { return live_count_ != 0U; });
+  if (r.status != PgsStatus::kOk) return r;
   const std::uint32_t level = first_live_;
   const std::uint32_t n = node_count(level);
   if (has_anchor()) {

@@ -228,6 +228,11 @@ class SegmentGraph {
     ++misuse_count_;
     return s;
   }
+  // The checks of every sample_*() call, in order: initialised, u in [0, 1), then
+  // levels_live() (whether the levels it draws from are live, asked only when the graph
+  // is initialised). kOk, or the refusal (counted).
+  template <class LevelsLive>
+  PgsStatus check_sampling(double u, LevelsLive&& levels_live) const;  // segment_graph.cpp
 
   SegmentGraphOptions options_;
   PgsNode* nodes_ = nullptr;          // max_levels × nodes_per_level
