@@ -203,6 +203,12 @@ TEST(CliRun, progress_on_a_terminal_and_quiet) {
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   CHECK_TEXT(r.out.find("KiB") == std::string::npos, r.out.c_str());
   STRCMP_CONTAINS("sdpslam run: ", r.out.c_str());
+  // The summary is a result: on stdout (with stderr thrown away), as simulate's and
+  // convert's are.
+  r = sdpslam::test::run_program("(" + std::string(SDPSLAM_CLI_PATH) + " run " + log + " --mode dpslam --quiet --out " +
+                                 dir + "/o3 2>/dev/null)");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("sdpslam run: ", r.out.c_str());
 }
 
 // trajectory.tum holds the poses of trajectory.txt (TUM, as evo reads it), in both modes,

@@ -142,12 +142,11 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   switch (status) {
     case slam::SdpRunStatus::kOk:
       io::write_log_errors(stderr, s.log_errors, s.log_error_count, kLogErrorsShown);
-      std::fprintf(stderr,
-                   "sdpslam run: %llu scans (%llu processed, %llu segments) in %.1f s, %zu log errors; ICP error "
-                   "%.3f +- %.3f m over %llu samples; outputs in %s\n",
-                   static_cast<unsigned long long>(s.scans), static_cast<unsigned long long>(s.processed),
-                   static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
-                   s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
+      std::printf("sdpslam run: %llu scans (%llu processed, %llu segments) in %.1f s, %zu log errors; ICP error "
+                  "%.3f +- %.3f m over %llu samples; outputs in %s\n",
+                  static_cast<unsigned long long>(s.scans), static_cast<unsigned long long>(s.processed),
+                  static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
+                  s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
       report_odometry_repairs(s.odometry_reversals_repaired);
       report_implausible(s.odometry_jumps_removed, s.scans_stamped_backwards, s.first_backwards_at);
       return kExitOk;
@@ -177,9 +176,9 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   switch (st) {
     case slam::RunStatus::kOk:
       io::write_log_errors(stderr, summary.log_errors, summary.log_error_count, kLogErrorsShown);
-      std::fprintf(stderr, "sdpslam run: %llu scans (%llu processed) in %.1f s, %zu log errors; outputs in %s\n",
-                   static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
-                   summary.wall_time_s, summary.log_error_count, a.out.c_str());
+      std::printf("sdpslam run: %llu scans (%llu processed) in %.1f s, %zu log errors; outputs in %s\n",
+                  static_cast<unsigned long long>(summary.scans), static_cast<unsigned long long>(summary.processed),
+                  summary.wall_time_s, summary.log_error_count, a.out.c_str());
       report_odometry_repairs(summary.odometry_reversals_repaired);
       report_implausible(summary.odometry_jumps_removed, summary.scans_stamped_backwards, summary.first_backwards_at);
       return kExitOk;
