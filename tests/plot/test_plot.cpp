@@ -172,8 +172,11 @@ TEST(Plot, a_map_figure_has_its_map_path_marks_scale_bar_and_legend) {
   io::MapFigure f;
   f.title = "A room";
   f.map = &m;
-  for (int k = 0; k <= 200; ++k) f.path.push_back(io::StampedPose{k, Pose2{0.0 + 0.1 * k, 5.0, 0.0}});
-  f.points = {Pose2{20.0, 10.0, 0.0}, Pose2{20.1, 10.0, 0.0}};
+  std::vector<io::StampedPose> path;
+  for (int k = 0; k <= 200; ++k) path.push_back(io::StampedPose{k, Pose2{0.0 + 0.1 * k, 5.0, 0.0}});
+  const std::vector<Pose2> points = {Pose2{20.0, 10.0, 0.0}, Pose2{20.1, 10.0, 0.0}};
+  f.path = &path;
+  f.points = &points;
   std::string error;
   CHECK_TRUE_TEXT(plot::write_map_figure_png(dir + "/m.png", f, &error), error.c_str());
   const Rgb img = decode(dir + "/m.png");

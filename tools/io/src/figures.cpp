@@ -79,10 +79,20 @@ bool plain_map(const std::string& path, const MapFigure& f, std::string* error) 
     if (error != nullptr) *error = "cannot draw '" + path + "': no map";
     return false;
   }
-  return write_map_png(path, *f.map, f.path, f.points, error);
+  return write_map_png(path, *f.map, f.path_poses(), f.point_poses(), error);
 }
 
 }  // namespace
+
+const std::vector<StampedPose>& MapFigure::path_poses() const {
+  static const std::vector<StampedPose> kNone;
+  return path != nullptr ? *path : kNone;
+}
+
+const std::vector<Pose2>& MapFigure::point_poses() const {
+  static const std::vector<Pose2> kNone;
+  return points != nullptr ? *points : kNone;
+}
 
 Painter plain_painter() { return Painter{plain_chart, plain_map}; }
 

@@ -77,11 +77,6 @@ std::vector<std::uint8_t> grey_pixels(const OccupancyImage& map, bool negate) {
 
 // ---- trajectory overlay ----------------------------------------------------------------
 
-using Rgb = Rgb8;
-constexpr Rgb kPathColour = kFigurePathColour;
-constexpr Rgb kStartColour = kFigureStartColour;
-constexpr Rgb kEndColour = kFigureEndColour;
-constexpr Rgb kPointColour = kFigurePointColour;
 constexpr int kMarkerHalfSize = 2;  // markers are 5 x 5 pixel squares
 
 class RgbCanvas {
@@ -90,7 +85,7 @@ class RgbCanvas {
       : w_(static_cast<long>(w)), h_(static_cast<long>(h)), px_(grey.size() * 3U) {
     for (std::size_t i = 0; i < grey.size(); ++i) px_[3 * i] = px_[3 * i + 1] = px_[3 * i + 2] = grey[i];
   }
-  void put(long x, long y, Rgb c) {
+  void put(long x, long y, Rgb8 c) {
     if (x < 0 || y < 0 || x >= w_ || y >= h_) return;
     const std::size_t i = 3U * (static_cast<std::size_t>(y) * static_cast<std::size_t>(w_) + static_cast<std::size_t>(x));
     px_[i] = c.r;
@@ -98,7 +93,7 @@ class RgbCanvas {
     px_[i + 2] = c.b;
   }
   // Bresenham's line algorithm (integer, all octants) between two pixel centres.
-  void line(long x0, long y0, long x1, long y1, Rgb c) {
+  void line(long x0, long y0, long x1, long y1, Rgb8 c) {
     const long dx = std::labs(x1 - x0);
     const long dy = -std::labs(y1 - y0);
     const long sx = x0 < x1 ? 1 : -1;
@@ -118,7 +113,7 @@ class RgbCanvas {
       }
     }
   }
-  void square(long x, long y, Rgb c) {
+  void square(long x, long y, Rgb8 c) {
     for (long dy = -kMarkerHalfSize; dy <= kMarkerHalfSize; ++dy)
       for (long dx = -kMarkerHalfSize; dx <= kMarkerHalfSize; ++dx) put(x + dx, y + dy, c);
   }
@@ -179,7 +174,7 @@ void draw_points(const OccupancyImage& map, const std::vector<Pose2>& points, Rg
     if (u < 0.0 || v < 0.0 || u >= static_cast<double>(canvas->width()) || v >= static_cast<double>(canvas->height())) {
       continue;
     }
-    canvas->put(std::lround(std::floor(u)), std::lround(std::floor(v)), kPointColour);
+    canvas->put(std::lround(std::floor(u)), std::lround(std::floor(v)), kFigurePointColour);
   }
 }
 
@@ -202,14 +197,14 @@ void draw_trajectory(const OccupancyImage& map, const std::vector<StampedPose>& 
       double u0 = pu, v0 = pv, u1 = u, v1 = v;
       if (clip_segment(&u0, &v0, &u1, &v1, umax, vmax)) {
         canvas->line(std::lround(std::floor(u0)), std::lround(std::floor(v0)), std::lround(std::floor(u1)),
-                     std::lround(std::floor(v1)), kPathColour);
+                     std::lround(std::floor(v1)), kFigurePathColour);
       }
     }
     pu = u;
     pv = v;
     have_prev = true;
   }
-  auto mark = [&](const StampedPose* sp, Rgb c) {
+  auto mark = [&](const StampedPose* sp, Rgb8 c) {
     if (sp == nullptr) return;
     double u = 0.0;
     double v = 0.0;
@@ -217,8 +212,8 @@ void draw_trajectory(const OccupancyImage& map, const std::vector<StampedPose>& 
     if (u < -10.0 || v < -10.0 || u > umax + 10.0 || v > vmax + 10.0) return;
     canvas->square(std::lround(std::floor(u)), std::lround(std::floor(v)), c);
   };
-  mark(last, kEndColour);
-  mark(first, kStartColour);  // drawn last: a closed loop still shows where it began
+  mark(last, kFigureEndColour);
+  mark(first, kFigureStartColour);  // drawn last: a closed loop still shows where it began
 }
 
 // ---- PNG encoding in memory ------------------------------------------------------------

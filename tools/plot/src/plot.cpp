@@ -417,7 +417,7 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
   cairo_rectangle(c, off_x, off_y, draw_w, draw_h);
   cairo_clip(c);
   colour(c, io::kFigurePointColour, 0.8);
-  for (const Pose2& p : f.points) {
+  for (const Pose2& p : f.point_poses()) {
     if (!std::isfinite(p.x_m) || !std::isfinite(p.y_m)) continue;
     cairo_rectangle(c, u(p.x_m) - 0.75, v(p.y_m) - 0.75, 1.5, 1.5);
   }
@@ -427,7 +427,7 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
   colour(c, io::kFigurePathColour);
   cairo_set_line_width(c, 1.4);
   cairo_set_line_join(c, CAIRO_LINE_JOIN_ROUND);
-  for (const io::StampedPose& sp : f.path) {
+  for (const io::StampedPose& sp : f.path_poses()) {
     if (!std::isfinite(sp.pose.x_m) || !std::isfinite(sp.pose.y_m)) continue;
     if (first == nullptr) {
       cairo_move_to(c, u(sp.pose.x_m), v(sp.pose.y_m));
@@ -514,12 +514,12 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
     text(c, label, lx + 26.0, ly, 0.0, 0.5);
     lx += 26.0 + text_width(c, label) + 18.0;
   };
-  if (!f.path.empty()) {
+  if (!f.path_poses().empty()) {
     entry(f.path_label, 0);
     entry("start", 1);
     entry("end", 2);
   }
-  if (!f.points.empty()) entry(f.points_label, 3);
+  if (!f.point_poses().empty()) entry(f.points_label, 3);
   grey(c, 0.3);
   text(c, "occupied: black, free: white, unknown: grey", fig_w - static_cast<double>(kSide), by + 24.0, 1.0, 0.0);
   return write_png(surface.get(), path, error);

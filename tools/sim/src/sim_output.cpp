@@ -119,7 +119,7 @@ OutputStatus simulate_to_directory(const World& world, const std::string& world_
   io::MapFigure figure;
   figure.title = "Simulated world '" + world_name + "' and the ground-truth path";
   figure.map = &map;
-  figure.path = outputs->ground_truth;
+  figure.path = &outputs->ground_truth;
   figure.path_label = "ground truth";
   if (!painter.map(files.map_png, figure, error)) return OutputStatus::kIoError;
   if (!set.commit(error)) return OutputStatus::kIoError;

@@ -141,8 +141,8 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
   io::MapFigure figure;
   figure.title = options.have_start ? "Localization on the map (from the given start)" : "Localization on the map (global start)";
   figure.map = &image;
-  figure.path = trajectory;
-  figure.points = final_set;
+  figure.path = &trajectory;
+  figure.points = &final_set;
   figure.points_label = "final particles";
   if (!options.painter.map(outputs.path("map.png"), figure, error)) return LocalizeStatus::kIoError;
   std::string particles = "# x_m y_m theta_rad: the final particle set\n";

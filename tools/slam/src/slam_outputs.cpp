@@ -82,7 +82,7 @@ bool write_trajectory_and_map(const std::string& out_dir, const std::vector<io::
     io::MapFigure figure;
     figure.title = "Map and path";
     figure.map = &image;
-    figure.path = trajectory;
+    figure.path = &trajectory;
     const io::Painter plain = io::plain_painter();
     if (!(painter != nullptr ? *painter : plain).map(out_dir + "/map.png", figure, error)) return false;
   }

@@ -63,13 +63,17 @@ struct Chart {
 };
 
 // A map with the path on it (start and end marked) and points (a particle set) under it.
+// The figure refers to the caller's data (null: none), which must outlive the drawing.
 struct MapFigure {
   std::string title;
   const OccupancyImage* map = nullptr;
-  std::vector<StampedPose> path;
+  const std::vector<StampedPose>* path = nullptr;
   std::string path_label = "path";
-  std::vector<Pose2> points;
+  const std::vector<Pose2>* points = nullptr;
   std::string points_label = "particles";
+  // The path and the points, empty when not given.
+  const std::vector<StampedPose>& path_poses() const;
+  const std::vector<Pose2>& point_poses() const;
 };
 
 // A painter writes a figure to a PNG file; false with `error` naming the file and why.
