@@ -95,7 +95,9 @@ contents)
   errors=0
   bad() { printf 'packaging: FAIL: %s\n' "$*" >&2; errors=$((errors + 1)); }
   has() {  # DEB PATH
-    dpkg-deb -c "$1" | awk '{print $6}' | grep -qx "./${2#/}" || bad "$(basename "$1") lacks /${2#/}"
+    # grep reads the whole listing (no -q): a grep that quits at the first match makes
+    # dpkg-deb die of SIGPIPE, which pipefail turns into a false "lacks".
+    dpkg-deb -c "$1" | awk '{print $6}' | grep -x "./${2#/}" >/dev/null || bad "$(basename "$1") lacks /${2#/}"
   }
   for deb in "$rt" "$dev"; do
     a=$(dpkg-deb -f "$deb" Architecture)
