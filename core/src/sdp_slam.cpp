@@ -174,6 +174,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     return false;
   }
   const std::size_t used0 = arena.used_bytes();
+  state_begin_ = arena.cursor();
   options_ = s;
   bottom_options_ = b;
   n_bottom_ = b.particle_count;
@@ -272,6 +273,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   rng_.reseed(seed ^ 0x5D95E6A1C3B2F407ULL);
   stats_ = SdpStats{};
   arena_used_ = arena.used_bytes() - used0;
+  state_end_ = arena.cursor();
   why_[0] = '\0';
   initialised_ = true;
   return true;

@@ -2,6 +2,9 @@
 // whose oldest levels become permanent, under the allocation counter.
 #include <CppUTest/TestHarness.h>
 
+#include <cstring>
+#include <vector>
+
 #include "alloc_counter.h"
 #include "sdp_harness.h"
 
@@ -103,4 +106,51 @@ TEST(SdpNoHeap, wide_loop_search_allocates_nothing_after_init) {
   s.loop_closure = true;
   s.loop_search_window_m = 3.0;
   run_without_heap(s);
+}
+
+namespace {
+// Into and out of a buffer sized beforehand.
+class FixedBuffer final : public StateWriter, public StateReader {
+ public:
+  explicit FixedBuffer(std::size_t bytes) : bytes_(bytes, 0) {}
+  bool write(const void* data, std::size_t n) override {
+    if (n > bytes_.size() - end_) return false;
+    std::memcpy(bytes_.data() + end_, data, n);
+    end_ += n;
+    return true;
+  }
+  bool read(void* data, std::size_t n) override {
+    if (n > end_ - at_) return false;
+    std::memcpy(data, bytes_.data() + at_, n);
+    at_ += n;
+    return true;
+  }
+  std::vector<unsigned char> bytes_;
+  std::size_t end_ = 0U;
+  std::size_t at_ = 0U;
+};
+}  // namespace
+
+// Snapshots: writing the state and reading it into another engine touch no heap either
+// (the robot writes them while it maps).
+TEST(SdpNoHeap, snapshots_allocate_nothing) {
+  CHECK_TRUE(sdpslam::test::allocation_counting_active());
+  SdpOptions s = test::small_sdp_options();
+  s.loop_closure = true;
+  s.loop_search_window_m = 3.0;
+  const test::ScanSet set(1);
+  test::SdpRig a;
+  test::SdpRig b;
+  CHECK_TRUE(a.init(test::sim_options(5), s, 8U));
+  CHECK_TRUE(b.init(test::sim_options(5), s, 8U));
+  for (std::size_t i = 0; i < set.scans.size() / 2U; ++i) a.slam->process(set.odom(i), *set.scans[i]);
+  FixedBuffer buffer(static_cast<std::size_t>(a.slam->state_bytes()));
+  {
+    sdpslam::test::AllocationScope scope;
+    CHECK_TRUE(a.slam->save_state(buffer));
+    CHECK_TRUE(b.slam->load_state(buffer));
+    for (std::size_t i = set.scans.size() / 2U; i < set.scans.size(); ++i) b.slam->process(set.odom(i), *set.scans[i]);
+    LONGS_EQUAL(0, scope.allocations());
+  }
+  LONGS_EQUAL(buffer.end_, buffer.at_);
 }

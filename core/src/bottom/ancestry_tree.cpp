@@ -405,4 +405,21 @@ bool AncestryTree::invariants_hold() const {
   return true;
 }
 
+
+void AncestryTree::transfer_state(StateIo& io) {
+  io.section("ancestry_tree");
+  nodes_.transfer_state(io);
+  paths_.transfer_state(io);
+  io.value(first_root_);
+  io.value(last_root_);
+  io.value(active_count_);
+  io.value(label_counter_);
+  io.value(tree_counter_);
+  io.value(node_oom_count_);
+  io.value(path_oom_count_);
+  io.value(misuse_count_);
+  io.value(committed_count_);
+  io.value(pruned_);
+}
+
 }  // namespace sdpslam

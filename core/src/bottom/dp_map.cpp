@@ -645,4 +645,24 @@ bool DpMap::invariants_hold() const {
   return in_nodes == obs_total;
 }
 
+
+void DpMap::transfer_state(StateIo& io) {
+  io.section("dp_map");
+  tiles_pool_.transfer_state(io);
+  obs_pool_.transfer_state(io);
+  // Slot 0 of each pool, set by the first allocation.
+  io.arena_pointer(tiles_, "dp map tiles");
+  io.arena_pointer(obs_, "dp map observations");
+  io.value(owner_free_count_);
+  io.value(touched_tx0_);
+  io.value(touched_ty0_);
+  io.value(touched_tx1_);
+  io.value(touched_ty1_);
+  io.value(tile_oom_count_);
+  io.value(observation_oom_count_);
+  io.value(observations_made_);
+  io.value(out_of_bounds_count_);
+  io.value(misuse_count_);
+}
+
 }  // namespace sdpslam

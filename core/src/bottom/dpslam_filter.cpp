@@ -389,4 +389,30 @@ bool DpSlamFilter::pop_anchored_observation(NodeId node, std::int32_t* ix, std::
   return map_.pop_observation(node, ix, iy, value);
 }
 
+
+void DpSlamFilter::transfer_state(StateIo& io) {
+  io.section("dpslam_filter");
+  tree_.transfer_state(io);
+  map_.transfer_state(io);
+  view_.transfer_state(io);
+  rng_.transfer_state(io);
+  io.value(stats_);
+  io.value(rays_);
+  io.value(seed_rays_);
+  io.value(seed_stamp_us_);
+  io.value(seed_pose_);
+  io.value(seed_committed_);
+  io.value(seed_head_);
+  io.value(seed_count_);
+  io.value(rays_stamp_us_);
+  // The two generations swap each step: which block is which travels as an offset.
+  io.arena_pointer(particles_, "filter particles");
+  io.arena_pointer(next_, "filter next generation");
+  io.value(best_index_);
+  io.value(started_);
+  io.value(last_odom_);
+  io.value(last_best_pose_);
+  io.value(restart_refused_count_);
+}
+
 }  // namespace sdpslam

@@ -61,4 +61,15 @@ bool ViewCache::lookup(std::int32_t ix, std::int32_t iy, CellObservation* out) {
   return seen;
 }
 
+
+void ViewCache::transfer_state(StateIo& io) {
+  io.section("view_cache");
+  io.value(used_);
+  io.value(generation_);
+  io.arena_pointer(map_, "view cache map");
+  io.value(particle_);
+  io.value(hits_);
+  io.value(misses_);
+}
+
 }  // namespace sdpslam

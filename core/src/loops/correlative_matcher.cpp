@@ -368,4 +368,30 @@ CorrelativeResult CorrelativeMatcher::match(const Point2* target, std::uint32_t 
   return finish();
 }
 
+void CorrelativeMatcher::transfer_state(StateIo& io) {
+  io.section("correlative");
+  io.value(options_);  // the search in progress's
+  io.value(result_);
+  io.arena_pointer(source_, "loop search source points");
+  io.value(source_count_);
+  io.value(guess_);
+  io.value(cx_);
+  io.value(cy_);
+  io.value(gcx_);
+  io.value(gcy_);
+  io.value(ox_);
+  io.value(oy_);
+  io.value(step_rad_);
+  io.value(half_headings_);
+  io.value(headings_);
+  io.value(next_heading_);
+  io.value(nq_);
+  io.value(steps_);
+  io.value(best_);
+  io.value(nbest_);
+  io.value(active_);
+  io.value(w_);
+  io.value(h_);
+}
+
 }  // namespace sdpslam

@@ -388,4 +388,11 @@ void FrameGraph::optimise() {
   stats_.last_downweighted = down;
 }
 
+void FrameGraph::transfer_state(StateIo& io) {
+  io.section("frame_graph");
+  io.value(stats_);
+  io.value(n_);
+  io.value(loops_);
+}
+
 }  // namespace sdpslam

@@ -482,4 +482,21 @@ std::uint32_t LoopClosure::level_hops(std::uint32_t older_level, std::uint32_t n
   return hops_[b];
 }
 
+void LoopClosure::transfer_state(StateIo& io) {
+  io.section("loop_closure");
+  io.value(count_);
+  graph_.transfer_state(io);
+  matcher_.transfer_state(io);
+  io.value(search_level_);
+  io.value(search_newer_);
+  io.value(search_count_);
+  io.value(search_cursor_);
+  io.value(search_a_count_);
+  io.value(search_b_count_);
+  io.value(search_pair_older_);
+  io.value(search_pair_newer_);
+  io.value(recentring_);
+  io.value(recentred_);
+}
+
 }  // namespace sdpslam

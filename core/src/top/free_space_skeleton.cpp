@@ -314,4 +314,15 @@ SkeletonResult FreeSpaceSkeleton::extract(const GridPatchView& patch, const Skel
   return r;
 }
 
+void FreeSpaceSkeleton::transfer_state(StateIo& io) {
+  io.section("skeleton");
+  io.value(last_width_);
+  io.value(last_height_);
+  io.value(last_resolution_m_);
+  io.value(last_has_obstacle_);
+  io.value(extract_count_);
+  io.value(failed_extract_count_);
+  io.value(overflow_count_);
+}
+
 }  // namespace sdpslam

@@ -366,4 +366,12 @@ bool Icp2d::direction_information(const Point2* target, std::size_t target_count
   return true;
 }
 
+// The index and pair buffers are rebuilt by every match: only the counters persist.
+void Icp2d::transfer_state(StateIo& io) {
+  io.section("icp");
+  io.value(cell_m_);
+  io.value(match_count_);
+  io.value(failed_match_count_);
+}
+
 }  // namespace sdpslam

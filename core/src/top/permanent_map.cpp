@@ -238,4 +238,23 @@ PermanentMap::Cell PermanentMap::cell(std::int32_t ix, std::int32_t iy) const {
   return slot == kNone ? Cell{} : cell_in(slot, cx, cy);
 }
 
+void PermanentMap::transfer_state(StateIo& io) {
+  io.section("permanent_map");
+  std::uint32_t capacity = tile_capacity_;
+  io.value(capacity);
+  if (io.ok() && capacity != tile_capacity_) io.fail("permanent map capacity differs", nullptr);
+  io.value(tiles_used_);
+  io.value(table_mask_);
+  io.value(table_shift_);
+  io.value(scale_log2_);
+  io.value(compactions_);
+  io.value(tx0_);
+  io.value(ty0_);
+  io.value(tx1_);
+  io.value(ty1_);
+  io.value(known_cells_);
+  io.value(refused_untagged_);
+  io.value(refused_no_tile_);
+}
+
 }  // namespace sdpslam

@@ -388,4 +388,17 @@ bool SegmentGraph::invariants_hold() const {
   return true;
 }
 
+void SegmentGraph::transfer_state(StateIo& io) {
+  io.section("segment_graph");
+  io.value(anchor_);
+  io.value(anchor_frame_);
+  io.value(head_);
+  io.value(first_live_);
+  io.value(live_count_);
+  io.value(peak_live_);
+  io.value(permanent_count_);
+  io.value(full_count_);
+  io.value(misuse_count_);
+}
+
 }  // namespace sdpslam

@@ -65,4 +65,13 @@ SegmentEnd Segmenter::on_processed(std::int64_t stamp_us, const Pose2& odom, con
   return SegmentEnd::kNone;
 }
 
+void Segmenter::transfer_state(StateIo& io) {
+  io.section("segmenter");
+  io.value(start_stamp_us_);
+  io.value(last_odom_);
+  io.value(scans_);
+  io.value(travel_m_);
+  io.value(last_dispersion_m_);
+}
+
 }  // namespace sdpslam

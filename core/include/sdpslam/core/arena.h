@@ -64,6 +64,9 @@ class Arena {
     return typed;
   }
 
+  // Where the next block would start (before alignment): blocks carved between two
+  // readings of it lie between them.
+  unsigned char* cursor() const { return base_ != nullptr ? base_ + used_bytes_ : nullptr; }
   std::size_t capacity_bytes() const { return capacity_bytes_; }
   std::size_t used_bytes() const { return used_bytes_; }
   std::size_t available_bytes() const { return capacity_bytes_ - used_bytes_; }

@@ -20,6 +20,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/handle.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -105,6 +106,19 @@ class IPool {
       if (s >= capacity_ || ++free_count > capacity_ - in_use) return false;
     }
     return free_count + in_use == capacity_;
+  }
+
+  // Snapshot of the bookkeeping (state_io.h). The slots, free links and generations are
+  // the storage's: an ArenaPool's travel with the arena.
+  void transfer_state(StateIo& io) {
+    std::uint32_t capacity = capacity_;
+    io.value(capacity);
+    if (io.ok() && capacity != capacity_) io.fail("pool capacity differs", nullptr);
+    io.value(size_);
+    io.value(free_head_);
+    io.value(peak_used_);
+    io.value(oom_count_);
+    io.value(misuse_count_);
   }
 
  protected:

@@ -6,6 +6,8 @@
 // Cost: a few ns per draw; no heap; 40 bytes of state.
 #include <cstdint>
 
+#include "sdpslam/core/state_io.h"
+
 namespace sdpslam {
 
 // splitmix64 (Steele, Lea & Flood 2014): expands one 64-bit seed into a stream.
@@ -33,6 +35,13 @@ class Rng {
   double gaussian();
   // N(0, sigma^2); sigma <= 0 gives exactly 0 without consuming randomness.
   double gaussian(double sigma) { return sigma > 0.0 ? sigma * gaussian() : 0.0; }
+
+  // The generator's state, for snapshots (core/state_io.h).
+  void transfer_state(StateIo& io) {
+    io.value(s_);
+    io.value(spare_);
+    io.value(has_spare_);
+  }
 
  private:
   std::uint64_t s_[4] = {};

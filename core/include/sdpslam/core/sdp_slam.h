@@ -256,6 +256,24 @@ class SdpSlam {
   // Mean/std of the ICP error over the top-level particles that have one (0 if none).
   void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;
 
+  // ---- snapshots (core/state_io.h) ----------------------------------------------------
+  // The complete state, between two process() calls: the arena blocks carved by init()
+  // and every member that changed since, so that an engine initialised with the same
+  // options and build and given load_state() continues exactly as this one would (the
+  // same poses and maps, bit for bit). The permanent sink and the listener are the
+  // caller's: their data is not part of it. False (why() says where) iff the writer
+  // failed or the engine is not initialised. No heap.
+  bool save_state(StateWriter& writer);
+  // Replaces the whole state with a stream from save_state(). Call after init() with the
+  // options the stream was written with: a stream of another build, of options that lay
+  // the arena out otherwise, or cut short is refused (false, why() names the part);
+  // options that keep the layout are not told apart here (the snapshot file is keyed to
+  // the configuration, io/snapshot_file.h). After a refusal the engine is unusable
+  // (process() does nothing) until init() on a fresh arena.
+  bool load_state(StateReader& reader);
+  // Bytes save_state() writes for this engine (the snapshot's size before compression).
+  std::uint64_t state_bytes() const;
+
   // Pure helper: share (m²) of the overlap of two axis-aligned boxes.
   static double box_overlap_m2(const double a[4], const double b[4]);
 
@@ -407,6 +425,8 @@ class SdpSlam {
   // Index of a level's frame in the best combination's frame graph, if it is part of it.
   bool graph_index(std::uint32_t level, std::uint32_t* index) const;
   void adjust_frames();
+  // Both directions of a snapshot (save_state / load_state).
+  void transfer_state(StateIo& io);
   // Obstacle points and global frame of a level in the best combination (permanent or
   // live); false if the level is no longer held.
   bool level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
@@ -520,6 +540,8 @@ class SdpSlam {
   std::uint32_t best_top_ = 0U;
   Pose2 current_frame_{};
   std::size_t arena_used_ = 0U;
+  unsigned char* state_begin_ = nullptr;  // the arena blocks init() carved
+  unsigned char* state_end_ = nullptr;
   bool initialised_ = false;
   char why_[200] = {};
 };

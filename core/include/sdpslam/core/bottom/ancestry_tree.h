@@ -40,6 +40,7 @@
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pool.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -236,6 +237,8 @@ class AncestryTree {
   // set_active) every leaf is active, every inactive node has ≥2 children and
   // size ≤ 2·active − 1; DFS labels nest exactly as the tree does.
   bool invariants_hold() const;
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Node {

@@ -53,6 +53,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pool.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -257,6 +258,8 @@ class DpMap final : public TreeListener {
   // tile table and tile back-references agree; each tile's count equals its entries
   // and no tile in use is empty; list lengths add up to the pool counts.
   bool invariants_hold() const;
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;

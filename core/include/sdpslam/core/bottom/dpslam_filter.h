@@ -45,6 +45,7 @@
 #include "sdpslam/core/range_scan.h"
 #include "sdpslam/core/rng.h"
 #include "sdpslam/core/bottom/view_cache.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -144,6 +145,8 @@ class DpSlamFilter {
   Pose2 particle_pose(std::uint32_t i) const { return i < particle_count_ ? particles_[i].pose : Pose2{}; }
   NodeId particle_node(std::uint32_t i) const { return i < particle_count_ ? particles_[i].node : kNoNode; }
   bool initialised() const { return initialised_; }
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Particle {

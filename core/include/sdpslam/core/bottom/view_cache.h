@@ -16,6 +16,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/bottom/dp_map.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -34,6 +35,8 @@ class ViewCache {
   // Reads answered here / passed to the map since init (for benchmarks and tests).
   std::uint64_t hits() const { return hits_; }
   std::uint64_t misses() const { return misses_; }
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Slot {

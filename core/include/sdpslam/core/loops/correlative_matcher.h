@@ -43,6 +43,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -113,6 +114,9 @@ class CorrelativeMatcher {
   const CorrelativeResult& result() const { return result_; }
   // Grid reads of one heading's coarse pass (source points × blocks), for budgets.
   std::uint64_t heading_cost() const;
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Candidate {

@@ -33,6 +33,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -113,6 +114,9 @@ class FrameGraph {
   // Kernel weight of loop constraint l after the last solve (1 = fully trusted).
   double loop_weight(std::uint32_t l) const { return loop_w_[l]; }
   const FrameGraphStats& stats() const { return stats_; }
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Constraint {

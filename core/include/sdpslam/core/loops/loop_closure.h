@@ -49,6 +49,7 @@
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -149,6 +150,9 @@ class LoopClosure {
 
   std::uint32_t record_count() const { return count_; }
   const Record& record(std::uint32_t k) const { return records_[k]; }
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   bool record_dead(const Record& r) const;

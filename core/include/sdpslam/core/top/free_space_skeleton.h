@@ -33,6 +33,7 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
+#include "sdpslam/core/state_io.h"
 #include "sdpslam/core/top/icp2d.h"  // Point2
 
 namespace sdpslam {
@@ -119,6 +120,9 @@ class FreeSpaceSkeleton {
   std::uint32_t extract_count() const { return extract_count_; }
   std::uint32_t failed_extract_count() const { return failed_extract_count_; }
   std::uint32_t overflow_count() const { return overflow_count_; }
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   static constexpr std::uint32_t kNoFeature = 0xFFFFFFFFU;

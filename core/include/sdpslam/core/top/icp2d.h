@@ -43,6 +43,7 @@
 
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -143,6 +144,9 @@ class Icp2d {
   // Diagnostics over the object's lifetime (never decrease).
   std::uint32_t match_count() const { return match_count_; }
   std::uint32_t failed_match_count() const { return failed_match_count_; }
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;

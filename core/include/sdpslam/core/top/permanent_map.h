@@ -49,6 +49,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/bottom/dp_map.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -101,6 +102,9 @@ class PermanentMap {
   std::uint32_t scale_log2() const { return scale_log2_; }
   std::uint64_t compactions() const { return compactions_; }
   bool initialised() const { return table_ != nullptr; }
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   static constexpr std::uint32_t kSideLog2 = capacity::kDpTileSideLog2;

@@ -51,6 +51,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -210,6 +211,9 @@ class SegmentGraph {
   std::uint32_t misuse_count() const { return misuse_count_; }  // other refused calls
   // Full self-check: ring bookkeeping, node counts, node labels, edge sanity, counters.
   bool invariants_hold() const;
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   struct Edge {

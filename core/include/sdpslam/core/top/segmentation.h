@@ -13,6 +13,7 @@
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
 
@@ -40,6 +41,9 @@ class Segmenter {
 
   // RMS distance (m) of the positions to their mean; 0 for n < 2.
   static double dispersion_m(const Pose2* poses, std::uint32_t n);
+
+  // The mutable state, for snapshots (core/state_io.h): what init() did not fix.
+  void transfer_state(StateIo& io);
 
  private:
   const SdpOptions& options_;
