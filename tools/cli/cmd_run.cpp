@@ -1,6 +1,7 @@
 // `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
 //               [--topology sdp|segslam] [--profile accurate|paper] [--config FILE.ini]
-//               [--seed S] [--memory-budget-mib M] --out DIR`
+//               [--seed S] [--memory-budget-mib M] [--snapshot FILE [--snapshot-every-s S]]
+//               [--resume FILE] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
 // (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
@@ -16,6 +17,7 @@
 #include "sdpslam/slam/run_offline.h"
 #include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/run_sdp.h"
+#include "sdpslam/io/snapshot_file.h"
 
 namespace sdpslam::cli {
 namespace {
@@ -35,7 +37,31 @@ struct RunArgs {
   std::uint64_t seed = 1U;
   std::string out;
   std::uint32_t memory_budget_mib = kDefaultMemoryBudgetMib;
+  std::string snapshot;
+  double snapshot_every_s = 0.0;
+  std::string resume;
 };
+
+// What sets the options of a run, for snapshots (io/snapshot_file.h): the mode, the
+// profile, the flags that override keys, and the configuration file's text. A snapshot
+// resumes only under the same (the seed is not part of it: the generators' state is).
+std::uint64_t config_fingerprint(const RunArgs& a, SdpProfile profile, std::string* error) {
+  std::string text = "mode=" + a.mode + "\nprofile=" + to_string(profile) + "\nparticles=" +
+                     std::to_string(a.particles) + "\ntop_particles=" + std::to_string(a.top_particles) +
+                     "\ntopology=" + a.topology + "\nconfig:\n";
+  if (!a.config.empty()) {
+    std::FILE* f = std::fopen(a.config.c_str(), "rb");
+    if (f == nullptr) {
+      *error = a.config + ": cannot be read";
+      return 0U;
+    }
+    char buf[4096];
+    std::size_t n = 0U;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0U) text.append(buf, n);
+    std::fclose(f);
+  }
+  return io::fingerprint(text);
+}
 
 int report(const char* what, int code, const std::string& error) {
   std::fprintf(stderr, "sdpslam run: %s%s\n", what, error.c_str());
@@ -134,6 +160,13 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   }
   ro.seed = a.seed;
   ro.painter = figure_painter();
+  ro.snapshot_path = a.snapshot;
+  ro.snapshot_every_s = a.snapshot_every_s;
+  ro.resume_path = a.resume;
+  if (!a.snapshot.empty() || !a.resume.empty()) {
+    ro.config_fingerprint = config_fingerprint(a, profile, &error);
+    if (!error.empty()) return report("", kExitBadInput, error);
+  }
   Progress progress("KiB", file_size_kib(a.log), a.quiet);
   ro.progress = [&progress](std::uint64_t bytes) { progress.update(bytes / 1024U); };
   slam::SdpRunSummary s;
@@ -147,6 +180,15 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
                   static_cast<unsigned long long>(s.scans), static_cast<unsigned long long>(s.processed),
                   static_cast<unsigned long long>(s.segments), s.wall_time_s, s.log_error_count, s.icp_error_mean_m,
                   s.icp_error_std_m, static_cast<unsigned long long>(s.icp_error_samples), a.out.c_str());
+      if (s.resumed_at_scan > 0U) {
+        std::printf("sdpslam run: resumed from %s after scan %llu\n", a.resume.c_str(),
+                    static_cast<unsigned long long>(s.resumed_at_scan));
+      }
+      if (s.snapshots_written > 0U) {
+        std::printf("sdpslam run: %llu snapshots written to %s (%.1f MiB, at most %.0f ms each)\n",
+                    static_cast<unsigned long long>(s.snapshots_written), a.snapshot.c_str(),
+                    static_cast<double>(s.snapshot_bytes) / (1024.0 * 1024.0), s.snapshot_write_ms_max);
+      }
       report_odometry_repairs(s.odometry_reversals_repaired);
       report_implausible(s.odometry_jumps_removed, s.scans_stamped_backwards, s.first_backwards_at);
       return kExitOk;
@@ -215,9 +257,24 @@ std::function<int()> setup_run(CLI::App& app) {
                  "memory_budget_mib (default 128)")
       ->check(whole_number(65536U))
       ->check(CLI::Range(8U, 65536U));
+  app.add_option("--snapshot", args->snapshot,
+                 "sdp: write the run's whole state to this file (replaced atomically) after the last scan, and every "
+                 "--snapshot-every-s of log time, so that --resume can continue it");
+  app.add_option("--snapshot-every-s", args->snapshot_every_s,
+                 "with --snapshot: also write it every this many seconds of log time (0 = only at the end)")
+      ->check(CLI::Range(0.0, 1.0e9));
+  app.add_option("--resume", args->resume,
+                 "sdp: continue the run a --snapshot file holds, on the same log with the same options (the scans "
+                 "it holds are not processed again; the outputs are those of an uninterrupted run)");
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
+    if (!sdp && (!args->snapshot.empty() || !args->resume.empty())) {
+      return report("", kExitUsage, "--snapshot and --resume apply to --mode sdp");
+    }
+    if (args->snapshot.empty() && args->snapshot_every_s > 0.0) {
+      return report("", kExitUsage, "--snapshot-every-s needs --snapshot");
+    }
     // Options of the top level mean nothing to DP-SLAM alone: refused, not ignored.
     if (!sdp && !args->profile.empty()) {
       return report("", kExitUsage, "--profile applies to --mode sdp (dpslam starts from tools/slam/default.ini)");

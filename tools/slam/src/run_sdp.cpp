@@ -18,6 +18,7 @@
 #include "sdpslam/io/log_reader.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"
+#include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/slam/slam_outputs.h"
@@ -280,6 +281,63 @@ bool sdp_check_options(const SdpRunOptions& options, std::string* why) {
   return false;
 }
 
+namespace {
+
+// The runner's part of a snapshot, before the engine's: what it has gathered from the
+// scans so far.
+constexpr char kRunnerPart[] = "sdpslam run sdp 1";
+
+struct RunnerState {
+  std::vector<ScanRecord> scans;
+  std::vector<Row> rows;
+};
+
+bool write_snapshot(const SdpRunOptions& options, const std::vector<ScanRecord>& scans, const std::vector<Row>& rows,
+                    const SdpPermanentPath& permanent, SdpSlam& slam, std::uint64_t* file_bytes, std::string* error) {
+  io::SnapshotOut out;
+  if (!out.open(options.snapshot_path, options.config_fingerprint, error)) return false;
+  out.put_bytes(kRunnerPart, sizeof kRunnerPart);
+  io::put_vector(out, scans);
+  io::put_vector(out, rows);
+  permanent.write_state(out);
+  if (!slam.save_state(out)) {
+    *error = options.snapshot_path + ": " + slam.why();
+    return false;
+  }
+  if (!out.commit(error)) return false;
+  *file_bytes = out.file_bytes();
+  return true;
+}
+
+bool read_snapshot(const SdpRunOptions& options, RunnerState* st, SdpPermanentPath* permanent, SdpSlam& slam,
+                   std::string* error) {
+  const std::string& path = options.resume_path;
+  io::SnapshotInfo info;
+  if (!io::check_snapshot(path, options.config_fingerprint, &info, error)) return false;
+  io::SnapshotIn in;
+  if (!in.open(path, error)) return false;
+  std::string part;
+  if (!in.get_bytes(&part, 64U) || part != std::string(kRunnerPart, sizeof kRunnerPart)) {
+    *error = path + ": not a snapshot of `sdpslam run` in sdp mode";
+    return false;
+  }
+  if (!io::get_vector(in, &st->scans) || !io::get_vector(in, &st->rows) || !permanent->read_state(in)) {
+    *error = path + ": snapshot's runner part is damaged";
+    return false;
+  }
+  if (!slam.load_state(in)) {
+    *error = path + ": " + slam.why();
+    return false;
+  }
+  if (!in.at_end()) {
+    *error = path + ": snapshot holds more than this program reads";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error) {
   const auto t_start = std::chrono::steady_clock::now();
@@ -313,7 +371,28 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   slam->set_permanent_sink(&permanent);
   slam->set_listener(&rows);
 
-  std::vector<ScanRecord> scans;
+  RunnerState resumed;
+  if (!options.resume_path.empty()) {
+    if (!read_snapshot(options, &resumed, &permanent, *slam, error)) return SdpRunStatus::kBadInput;
+    rows.rows = resumed.rows;
+  }
+  const std::size_t resume_at = resumed.scans.size();
+  std::vector<ScanRecord> scans = std::move(resumed.scans);
+  std::uint64_t snapshots = 0U;
+  std::uint64_t snapshot_bytes = 0U;
+  double snapshot_ms_max = 0.0;
+  // Log time of the last snapshot (or of the run's first scan).
+  bool snapshot_clock_set = !scans.empty();
+  std::int64_t last_snapshot_us = scans.empty() ? 0 : scans.back().stamp_us;
+  auto snapshot = [&]() {
+    const auto s0 = std::chrono::steady_clock::now();
+    if (!write_snapshot(options, scans, rows.rows, permanent, *slam, &snapshot_bytes, error)) return false;
+    ++snapshots;
+    snapshot_ms_max = std::max(
+        snapshot_ms_max, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count());
+    return true;
+  };
+
   std::vector<double> scan_ms;
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
   double cpu_max_by_kind[4] = {0.0, 0.0, 0.0, 0.0};
@@ -325,8 +404,22 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   std::vector<double> segment_ms;
   detail::ScanOdometryPairing pairing;
   OdometrySample od;
+  std::size_t index = 0U;  // of the scan (with odometry) in the log
   while (pairing.next(reader, &od)) {
     const io::LaserRecord& rec = reader.laser();
+    if (index < resume_at) {
+      // Held by the snapshot: the log must be the one it was made from.
+      if (rec.stamp_us != scans[index].stamp_us) {
+        *error = options.resume_path + ": made from another log (scan " + std::to_string(index + 1U) + " of " +
+                 log_path + " is stamped " + io::format_stamp_us(rec.stamp_us) + ", the snapshot's " +
+                 io::format_stamp_us(scans[index].stamp_us) + ")";
+        return SdpRunStatus::kBadInput;
+      }
+      ++index;
+      if (options.progress) options.progress(reader.input_offset());
+      continue;
+    }
+    ++index;
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
     const SdpStepResult r = slam->process(od, rec.scan);
@@ -344,11 +437,27 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
     scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
     if (options.progress) options.progress(reader.input_offset());
+    if (!options.snapshot_path.empty() && options.snapshot_every_s > 0.0) {
+      if (!snapshot_clock_set) {
+        snapshot_clock_set = true;
+        last_snapshot_us = rec.stamp_us;
+      } else if (static_cast<double>(rec.stamp_us - last_snapshot_us) * 1e-6 >= options.snapshot_every_s) {
+        if (!snapshot()) return SdpRunStatus::kIoError;
+        last_snapshot_us = rec.stamp_us;
+      }
+    }
   }
   if (scans.empty()) {
     *error = log_path + ": no laser scan with odometry in the log";
     return SdpRunStatus::kBadInput;
   }
+  if (index < resume_at) {
+    *error = options.resume_path + ": holds " + std::to_string(resume_at) + " scans, " + log_path + " only " +
+             std::to_string(index);
+    return SdpRunStatus::kBadInput;
+  }
+  // The last one: the state before finish(), which only completes pending work.
+  if (!options.snapshot_path.empty() && !snapshot()) return SdpRunStatus::kIoError;
   slam->finish();
 
   // The best combination's path: permanent segments, then the live chain.
@@ -399,6 +508,13 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js["odometry_jumps_removed"] = reader.odometry_jumps_removed();
   js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
   js.update(sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells));
+  js["resumed_at_scan"] = resume_at;
+  if (!options.snapshot_path.empty()) {
+    js["snapshots"] = {{"written", snapshots},
+                       {"file_bytes", snapshot_bytes},
+                       {"state_bytes", slam->state_bytes()},
+                       {"write_ms_max", ms(snapshot_ms_max)}};
+  }
   js["timing"] = {{"wall_time_s", ms(wall_s)},
                   {"scan_ms_p50", ms(percentile(scan_ms, 0.5))},
                   {"scan_ms_p99", ms(percentile(scan_ms, 0.99))},
@@ -425,6 +541,10 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->icp_error_mean_m = st.error_mean_m();
     summary->icp_error_std_m = st.error_std_m();
     summary->icp_error_samples = st.error_samples;
+    summary->resumed_at_scan = resume_at;
+    summary->snapshots_written = snapshots;
+    summary->snapshot_bytes = snapshot_bytes;
+    summary->snapshot_write_ms_max = snapshot_ms_max;
   }
   return SdpRunStatus::kOk;
 }

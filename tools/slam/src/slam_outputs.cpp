@@ -99,6 +99,19 @@ void SdpPermanentPath::on_pose(std::uint32_t level, std::int64_t stamp_us, const
   poses_.push_back(LocalPose{level, stamp_us, local});
 }
 
+void SdpPermanentPath::write_state(io::SnapshotOut& out) const {
+  io::put_vector(out, poses_);
+  io::put_vector(out, frames_);
+  out.put_u64(dropped_);
+}
+
+bool SdpPermanentPath::read_state(io::SnapshotIn& in) {
+  if (!io::get_vector(in, &poses_) || !io::get_vector(in, &frames_) || !in.get_u64(&dropped_)) return false;
+  // A bounded path keeps its room: the poses it may still take were reserved.
+  if (bounded_) return poses_.size() <= poses_.capacity() && frames_.size() <= frames_.capacity();
+  return true;
+}
+
 void SdpPermanentPath::on_frame(std::uint32_t level, const Pose2& frame_in_global) {
   if (level >= frames_.size()) {
     if (bounded_ && level >= frames_.capacity()) return;  // its poses were not stored either

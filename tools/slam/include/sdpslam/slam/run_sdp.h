@@ -46,6 +46,19 @@ struct SdpRunOptions {
   std::function<void(std::uint64_t input_bytes)> progress;
   // Draws map.png and icp_error.png (figures.h; the sdpslam CLI: plot::painter()).
   io::Painter painter = io::plain_painter();
+  // Snapshots (io/snapshot_file.h). With snapshot_path set, the run's state (this
+  // runner's and the engine's, SdpSlam::save_state) replaces that file every
+  // snapshot_every_s seconds of log time, and once after the last scan. With
+  // resume_path set, the run starts from that snapshot: the log is read again from its
+  // start, the scans the snapshot holds are checked against it (same stamps) and not
+  // processed again, and the outputs are those of a run that never stopped.
+  // config_fingerprint names the options (the caller's hash of everything that sets
+  // them): a snapshot written with other options, by another version, or damaged is
+  // refused (kBadInput) before anything is read from it.
+  std::string snapshot_path;
+  double snapshot_every_s = 0.0;
+  std::string resume_path;
+  std::uint64_t config_fingerprint = 0U;
 };
 
 struct SdpRunSummary : RunSummary {
@@ -53,6 +66,10 @@ struct SdpRunSummary : RunSummary {
   double icp_error_mean_m = 0.0;
   double icp_error_std_m = 0.0;
   std::uint64_t icp_error_samples = 0U;
+  std::uint64_t resumed_at_scan = 0U;  // scans the resumed snapshot held (0: from the start)
+  std::uint64_t snapshots_written = 0U;
+  std::uint64_t snapshot_bytes = 0U;   // the last one's file size
+  double snapshot_write_ms_max = 0.0;
 };
 
 enum class SdpRunStatus { kOk, kBadInput, kIoError, kInternal };

@@ -23,6 +23,7 @@
 #include "sdpslam/io/figures.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/io/trajectory_io.h"
 
 namespace sdpslam::slam {
@@ -93,6 +94,10 @@ class SdpPermanentPath final : public SdpPathSink {
   // The poses in the global frame, oldest first.
   std::vector<io::StampedPose> global_poses() const;
   std::uint64_t dropped() const { return dropped_; }
+  // Its contents in a snapshot (io/snapshot_file.h), and back; read_state() is false
+  // iff the snapshot does not hold them whole.
+  void write_state(io::SnapshotOut& out) const;
+  bool read_state(io::SnapshotIn& in);
 
  private:
   std::vector<LocalPose> poses_;
