@@ -2,6 +2,8 @@
 
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <time.h>
 
 #include <algorithm>
@@ -14,6 +16,7 @@
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/io/map_image.h"
+#include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::daemon {
@@ -53,6 +56,7 @@ bool Daemon::start(std::string* error) {
   if (config_.input_log && !recorder_.open(config_.output_directory + "/input.clf", error)) return false;
   start_us_ = io_.clock->now_us();
   next_output_us_ = start_us_ + config_.output_period_us;
+  next_snapshot_us_ = start_us_ + config_.snapshot_interval_us;
   log_.log(Event::kStartup, "mode %s, laser %s on %s, encoders %s, outputs every %.1f s in %s", io_.engine->name(),
            to_string(config_.laser_protocol), config_.laser_device.c_str(),
            drivers::to_string(config_.encoders.protocol), static_cast<double>(config_.output_period_us) * 1e-6,
@@ -226,7 +230,96 @@ void Daemon::step() {
     write_outputs();
     next_output_us_ = io_.clock->now_us() + config_.output_period_us;
   }
+  if (snapshot_child_ > 0) reap_snapshot(false);
+  if (snapshots_on() && now >= next_snapshot_us_) {
+    if (counters_.scans_placed != snapshot_at_scans_) write_snapshot(true);
+    next_snapshot_us_ = io_.clock->now_us() + config_.snapshot_interval_us;
+  }
   if (io_.watchdog != nullptr) io_.watchdog->pat();
+}
+
+bool Daemon::snapshots_on() const { return config_.snapshot_interval_us > 0 && io_.engine->has_snapshots(); }
+
+void Daemon::write_snapshot(bool may_fork) {
+  if (snapshot_child_ > 0) {
+    ++counters_.snapshots_skipped_busy;
+    return;
+  }
+  const std::int64_t t0 = io_.clock->now_us();
+  const std::uint64_t scans = counters_.scans_placed;
+  if (may_fork && io_.fork_snapshots) {
+    // The daemon is one thread: the child is a consistent copy of the whole state. It
+    // writes the file and leaves with _exit (no stdio flush, no atexit handler of the
+    // parent's runs twice); its error, if any, goes to stderr as its own line.
+    std::fflush(nullptr);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      std::string error;
+      std::uint64_t bytes = 0U;
+      const bool ok = io_.engine->save_snapshot(snapshot_path(config_), config_.slam_fingerprint, &bytes, &error);
+      if (!ok) dprintf(2, "sdpslamd: snapshot: %s\n", error.c_str());
+      ::_exit(ok ? 0 : 1);
+    }
+    if (pid > 0) {
+      snapshot_child_ = static_cast<int>(pid);
+      snapshot_child_scans_ = scans;
+      snapshot_child_started_us_ = t0;
+      return;
+    }
+    log_.log(Event::kOutput, "snapshot: fork failed (%s), written in the loop", std::strerror(errno));
+  }
+  std::string error;
+  std::uint64_t bytes = 0U;
+  const bool ok = io_.engine->save_snapshot(snapshot_path(config_), config_.slam_fingerprint, &bytes, &error);
+  snapshot_done(ok, error, scans, t0);
+}
+
+void Daemon::reap_snapshot(bool wait) {
+  int status = 0;
+  const pid_t r = ::waitpid(static_cast<pid_t>(snapshot_child_), &status, wait ? 0 : WNOHANG);
+  if (r == 0) return;  // still writing
+  const bool ok = r > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  snapshot_child_ = 0;
+  snapshot_done(ok, ok ? std::string() : "the writing process failed (its message is above)", snapshot_child_scans_,
+                snapshot_child_started_us_);
+}
+
+void Daemon::snapshot_done(bool ok, const std::string& error, std::uint64_t scans, std::int64_t started_us) {
+  if (ok) {
+    ++counters_.snapshots_written;
+    struct stat st{};
+    counters_.snapshot_bytes = ::stat(snapshot_path(config_).c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0U;
+    snapshot_at_scans_ = scans;
+  } else {
+    ++counters_.snapshot_failures;
+    log_.log(Event::kOutput, "snapshot not written, the previous one is kept: %s", error.c_str());
+  }
+  const std::int64_t dt = io_.clock->now_us() - started_us;
+  if (dt > counters_.max_snapshot_write_us) counters_.max_snapshot_write_us = dt;
+}
+
+std::string snapshot_path(const DaemonConfig& config) { return config.output_directory + "/snapshot.sdps"; }
+
+ResumeOutcome resume_from_snapshot(const DaemonConfig& config, SlamEngine& engine, EventLog& log) {
+  if (config.snapshot_interval_us <= 0 || !engine.has_snapshots()) return ResumeOutcome::kFresh;
+  const std::string path = snapshot_path(config);
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return ResumeOutcome::kFresh;
+  std::string error;
+  std::uint64_t scans = 0U;
+  if (engine.resume_snapshot(path, config.slam_fingerprint, &scans, &error)) {
+    log.log(Event::kStartup, "resumed the session of %s: %" PRIu64 " scans mapped before", path.c_str(), scans);
+    return ResumeOutcome::kResumed;
+  }
+  std::string aside;
+  std::string move_error;
+  if (io::keep_snapshot_aside(path, &aside, &move_error)) {
+    log.log(Event::kStartup, "snapshot refused, kept as %s; starting a new map: %s", aside.c_str(), error.c_str());
+  } else {
+    log.log(Event::kStartup, "snapshot refused (%s) and could not be moved aside (%s); starting a new map",
+            error.c_str(), move_error.c_str());
+  }
+  return ResumeOutcome::kRefused;
 }
 
 bool Daemon::run(const volatile std::sig_atomic_t* stop, volatile std::sig_atomic_t* localize) {
@@ -295,6 +388,10 @@ bool Daemon::switch_to_localization(std::string* error) {
 bool Daemon::finish() {
   update_odometry();
   place_scans(io_.clock->now_us(), true);
+  // The state a restart continues from: before finish(), which completes pending work at
+  // once rather than spread over scans as a run that goes on does it.
+  if (snapshot_child_ > 0) reap_snapshot(true);
+  if (snapshots_on() && counters_.scans_placed != snapshot_at_scans_) write_snapshot(false);
   io_.engine->finish();
   written_at_scans_ = ~std::uint64_t{0};  // finishing may move the path: always delivered
   return write_outputs();
@@ -442,6 +539,12 @@ std::string Daemon::status_json() const {
                    {"failures", c.output_failures},
                    {"unchanged", c.output_writes_unchanged},
                    {"max_write_ms", fixed3(static_cast<double>(c.max_output_write_us) / 1000.0)}};
+  js["snapshots"] = {{"enabled", snapshots_on()},
+                     {"written", c.snapshots_written},
+                     {"failures", c.snapshot_failures},
+                     {"file_bytes", c.snapshot_bytes},
+                     {"skipped_busy", c.snapshots_skipped_busy},
+                     {"max_write_ms", fixed3(static_cast<double>(c.max_snapshot_write_us) / 1000.0)}};
   js["events"] = {{"logged", log_.printed()}, {"suppressed", log_.suppressed()}};
   js["cpu"] = {{"user_s", fixed3(user_s)},
                {"system_s", fixed3(sys_s)},

@@ -3,12 +3,14 @@
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/serial_port.h"
+#include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/config_ini.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/run_sdp.h"
 
 #include <ini.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -42,6 +44,8 @@ struct ParseState {
   slam::IniDuplicates duplicates;
   int first_sdp_line = 0;  // the first [sdp] key and the [slam] profile key, for mode dpslam's warning
   int profile_line = 0;
+  // "section.key=value" of every key that shapes the SLAM state (DaemonConfig::slam_fingerprint).
+  std::vector<std::string> slam_keys;
 
   void fail(const std::string& why) {
     if (!error.empty()) return;
@@ -383,6 +387,11 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
     }
     if (key == "write_map") return ok(boolean(v, &c.write_map, why));
     if (key == "input_log") return ok(boolean(v, &c.input_log, why));
+    if (key == "snapshot_interval_s") {
+      if (!real_in(v, 0.0, 86400.0, false, &d, why)) return R::kBad;
+      c.snapshot_interval_us = static_cast<std::int64_t>(std::llround(d * 1e6));
+      return R::kOk;
+    }
   } else if (sec == "daemon") {
     if (key == "log_interval_s") {
       if (!real_in(v, 0.0, 3600.0, false, &d, why)) return R::kBad;
@@ -411,6 +420,14 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
   return R::kUnknown;
 }
 
+// Keys whose value the SLAM state depends on: a snapshot resumes only under the same
+// (the drivers, the outputs' timing and the daemon's own keys may change in between).
+bool shapes_slam_state(const std::string& sec, const char* name) {
+  if (sec == "slam" || sec == "sdp") return true;
+  if (sec == "output") return std::strcmp(name, "max_trajectory_scans") == 0;
+  return slam::is_slam_config_section(sec);
+}
+
 int handler(void* user, const char* section, const char* name, const char* value) {
   auto* st = static_cast<ParseState*>(user);
   const std::string sec(section);
@@ -423,7 +440,10 @@ int handler(void* user, const char* section, const char* name, const char* value
     if (sec == "sdp" && st->first_sdp_line == 0) st->first_sdp_line = st->line;
     if (sec == "slam" && std::strcmp(name, "profile") == 0) st->profile_line = st->line;
     const R r = handle_key(*st->config, sec, name, value, &why);
-    if (r == R::kOk) return 1;
+    if (r == R::kOk) {
+      if (shapes_slam_state(sec, name)) st->slam_keys.push_back(sec + "." + name + "=" + value);
+      return 1;
+    }
     if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
     else if (!slam::is_slam_config_section(sec) && sec != "sdp") why = sec + "." + name + ": " + why;
   }
@@ -460,10 +480,17 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
   (void)ini_parse_stream(read_line_quietly, f, profile_handler, config);
   if (config->mode == SlamMode::kSdp) apply_profile(config->profile, &config->slam.filter, &config->sdp);
   std::rewind(f);
-  ParseState st{config, path, {}, 0, f, 0, {}};
+  ParseState st{config, path, {}, 0, f, 0, {}, 0, 0, {}};
   const int rc = ini_parse_stream(read_line, &st, handler, &st);
   // inih's rc is the first line it could not parse or whose handler failed; a handler
   // failure has its reason here, so an earlier rc is a malformed line.
+  {
+    // Order-free: the same keys with the same values give the same fingerprint.
+    std::sort(st.slam_keys.begin(), st.slam_keys.end());
+    std::string text = std::string("mode=") + to_string(config->mode) + "\nprofile=" + to_string(config->profile) + "\n";
+    for (const std::string& k : st.slam_keys) text += k + "\n";
+    config->slam_fingerprint = io::fingerprint(text);
+  }
   if (rc > 0 && (st.error.empty() || rc < st.error_line)) {
     *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
     return false;

@@ -174,6 +174,15 @@ int run_daemon(int argc, char** argv) {
     std::fprintf(stderr, "sdpslamd: %s: %s\n", config_path.c_str(), error.c_str());
     return kExitBadInput;
   }
+  // The session a snapshot holds goes on; a refused one is kept aside and the map starts
+  // anew, on an engine that holds nothing of it.
+  if (daemon::resume_from_snapshot(config, *engine, log) == daemon::ResumeOutcome::kRefused) {
+    engine = daemon::make_engine(config, &error);
+    if (!engine) {
+      std::fprintf(stderr, "sdpslamd: %s: %s\n", config_path.c_str(), error.c_str());
+      return kExitInternal;
+    }
+  }
 
   // CAN: SocketCAN with the protocol's receive filters, or a candump replay.
   std::unique_ptr<hal::CanBus> bus;
@@ -241,6 +250,7 @@ int run_daemon(int argc, char** argv) {
   io.laser_stream = &port;
   io.engine = engine.get();
   io.watchdog = &notifier;
+  io.fork_snapshots = true;  // the loop does not pause while the state is written
   auto d = std::make_unique<daemon::Daemon>(config, io, log);
   d->adopt_engine(std::move(engine));
   if (!d->start(&error)) {

@@ -3,6 +3,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
+#include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/slam_outputs.h"
 
@@ -126,7 +127,19 @@ class SdpEngine final : public SlamEngine {
 
   const char* name() const override { return "sdp"; }
 
-  EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
+  EngineStep process(const OdometrySample& odom_in, const RangeScan& scan) override {
+    // After a resume the encoders' odometry starts again from its own origin: it is
+    // carried into the snapshot's odometry frame so that the robot continues from where
+    // the session left it (it is taken not to have moved while sdpslamd was down; the
+    // scan matching absorbs a small move).
+    if (rebase_pending_) {
+      odom_offset_ = last_odom_.compose(odom_in.pose.inverse());
+      rebase_pending_ = false;
+      rebased_ = true;
+    }
+    OdometrySample odom = odom_in;
+    if (rebased_) odom.pose = odom_offset_.compose(odom_in.pose);
+    last_odom_ = odom.pose;
     const SdpStepResult r = slam_->process(odom, scan);
     EngineStep s;
     s.processed = r.bottom.status == StepResult::Status::kProcessed;
@@ -161,7 +174,58 @@ class SdpEngine final : public SlamEngine {
 
   std::uint64_t unrecorded_scans() const override { return unrecorded_; }
 
+  bool has_snapshots() const override { return true; }
+
+  bool save_snapshot(const std::string& path, std::uint64_t fingerprint, std::uint64_t* file_bytes,
+                     std::string* error) override {
+    io::SnapshotOut out;
+    if (!out.open(path, fingerprint, error)) return false;
+    out.put_bytes(kSnapshotPart, sizeof kSnapshotPart);
+    io::put_vector(out, scans_);
+    out.put_u64(unrecorded_);
+    out.write(&last_odom_, sizeof last_odom_);
+    permanent_.write_state(out);
+    if (!slam_->save_state(out)) {
+      *error = path + ": " + slam_->why();
+      return false;
+    }
+    if (!out.commit(error)) return false;
+    *file_bytes = out.file_bytes();
+    return true;
+  }
+
+  bool resume_snapshot(const std::string& path, std::uint64_t fingerprint, std::uint64_t* scans,
+                       std::string* error) override {
+    io::SnapshotInfo info;
+    if (!io::check_snapshot(path, fingerprint, &info, error)) return false;
+    io::SnapshotIn in;
+    if (!in.open(path, error)) return false;
+    std::string part;
+    if (!in.get_bytes(&part, 64U) || part != std::string(kSnapshotPart, sizeof kSnapshotPart)) {
+      *error = path + ": not a snapshot of sdpslamd in mode sdp";
+      return false;
+    }
+    // The records keep the room reserved at create time: a longer one is refused.
+    if (!io::get_vector(in, &scans_, scans_.capacity()) || !in.get_u64(&unrecorded_) ||
+        !in.read(&last_odom_, sizeof last_odom_) || !permanent_.read_state(in)) {
+      *error = path + ": the snapshot's records are damaged or longer than [output] max_trajectory_scans";
+      return false;
+    }
+    if (!slam_->load_state(in)) {
+      *error = path + ": " + slam_->why();
+      return false;
+    }
+    if (!in.at_end()) {
+      *error = path + ": the snapshot holds more than this program reads";
+      return false;
+    }
+    *scans = scans_.size() + unrecorded_;
+    rebase_pending_ = true;
+    return true;
+  }
+
  private:
+  static constexpr char kSnapshotPart[] = "sdpslamd sdp 1";
   std::size_t arena_bytes_ = 0U;
   std::unique_ptr<unsigned char[]> buffer_;
   std::unique_ptr<Arena> arena_;
@@ -169,6 +233,10 @@ class SdpEngine final : public SlamEngine {
   slam::SdpPermanentPath permanent_;  // the segments made permanent
   std::vector<slam::ScanRecord> scans_;
   std::uint64_t unrecorded_ = 0U;
+  Pose2 last_odom_{};     // the last scan's odometry, in the session's odometry frame
+  Pose2 odom_offset_{};   // session frame ⊕ this = the encoders' frame since a resume
+  bool rebase_pending_ = false;
+  bool rebased_ = false;
   mutable std::uint64_t path_gaps_ = 0U;
   mutable std::uint32_t known_cells_ = 0U;
 };

@@ -139,6 +139,7 @@ TEST(SdpslamdConfig, the_shipped_file_sets_every_key_to_its_built_in_default) {
       SDPSLAM_FIELD("output.max_trajectory_scans", max_trajectory_scans),
       SDPSLAM_FIELD("output.write_map", write_map),
       SDPSLAM_FIELD("output.input_log", input_log),
+      SDPSLAM_FIELD("output.snapshot_interval_s", snapshot_interval_us),
       SDPSLAM_FIELD("daemon.log_interval_s", log_interval_us),
       SDPSLAM_FIELD("daemon.loop_slice_ms", loop_slice_us),
       SDPSLAM_FIELD("daemon.memory_budget_mib", memory_budget_mib),
@@ -523,4 +524,28 @@ TEST(SdpslamdConfig, localize_mode_needs_a_readable_map_and_a_well_formed_start)
   expect_rejected("[slam]\nmode = localize\n[localize]\nmap = " + dir + "/room.yaml\nstart = 1, 2\n", 5,
                   "'1, 2' is not a pose x, y, theta");
   expect_rejected("[slam]\nmode = localize\n[localize]\nmap = " + dir + "/none.yaml\n", 4, "none.yaml");
+}
+
+// Snapshots resume only under the configuration that wrote them: its fingerprint covers
+// the keys that shape the SLAM state, whatever their order, and nothing else.
+TEST(SdpslamdConfig, the_slam_fingerprint_covers_the_keys_that_shape_the_state_and_only_those) {
+  auto fp = [](const std::string& text) {
+    DaemonConfig c;
+    std::string error;
+    CHECK_TRUE_TEXT(load_daemon_config(write_ini(text), &c, &error), error.c_str());
+    return c.slam_fingerprint;
+  };
+  const std::string sections = "[filter]\nparticles = 8\n[sdp]\ntop_particles = 20\n";
+  const std::uint64_t a = fp(sections + "[output]\nperiod_s = 5\n");
+  CHECK(a != 0U);
+  CHECK(a == fp("[sdp]\ntop_particles = 20\n; a comment\n[output]\nperiod_s = 5\n[filter]\nparticles = 8\n"));
+  CHECK(a == fp(sections + "[laser]\ndevice = /dev/ttyUSB0\n[output]\nsnapshot_interval_s = 10\n"));
+  CHECK(a != fp("[filter]\nparticles = 9\n[sdp]\ntop_particles = 20\n"));
+  CHECK(a != fp(sections + "[output]\nmax_trajectory_scans = 1000\n"));
+  CHECK(a != fp(sections + "[slam]\nprofile = paper\n"));
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE(load_daemon_config(write_ini("[output]\nsnapshot_interval_s = 2.5\n"), &c, &error));
+  LONGS_EQUAL(2500000, c.snapshot_interval_us);
+  expect_rejected("[output]\nsnapshot_interval_s = -1\n", 2, "snapshot_interval_s");
 }

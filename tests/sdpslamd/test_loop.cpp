@@ -5,6 +5,7 @@
 
 #include <dirent.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
@@ -111,6 +112,14 @@ class FakeEngine final : public SlamEngine {
   }
   sdpslam::io::Json status_json() const override { return {{"fake", true}}; }
   std::uint64_t unrecorded_scans() const override { return 0U; }
+  bool has_snapshots() const override { return snapshots; }
+  bool save_snapshot(const std::string& path, std::uint64_t, std::uint64_t* bytes, std::string* error) override {
+    saved_at.push_back(got.size());
+    *bytes = 1U;
+    return io::write_file_atomic(path, std::to_string(got.size()), error);
+  }
+  bool snapshots = false;
+  std::vector<std::size_t> saved_at;  // scans the engine had at each snapshot
   std::vector<OdometrySample> got;
   io::OccupancyImage map;  // what the engine "mapped" (empty by default)
 };
@@ -144,7 +153,7 @@ struct Rig {
     config.loop_slice_us = 100;
   }
   ~Rig() { std::fclose(log_file); }
-  Daemon& make() {
+  Daemon& make(bool fork_snapshots = false) {
     DaemonIo io;
     io.clock = &clock;
     io.bus = &bus;
@@ -152,6 +161,7 @@ struct Rig {
     io.laser = &laser;
     io.engine = &engine;
     io.watchdog = &watchdog;
+    io.fork_snapshots = fork_snapshots;
     d = std::make_unique<Daemon>(config, io, log);
     std::string error;
     CHECK_TRUE_TEXT(d->start(&error), error.c_str());
@@ -344,6 +354,84 @@ TEST(SdpslamdLoop, finish_places_what_it_can_and_writes_outputs_atomically) {
   CHECK_TRUE(status["engine"]["fake"].get<bool>());
   LONGS_EQUAL(1, status["scans"]["skipped_no_odometry"].get<int>());
   CHECK_TRUE(status["cpu"]["user_s"].is_number());
+}
+
+// Mode sdp writes the whole state every [output] snapshot_interval_s while scans come,
+// none while the robot is idle, and one more at the stop before the engine finishes.
+TEST(SdpslamdLoop, snapshots_follow_the_interval_while_scans_come_and_one_is_written_at_the_stop) {
+  Rig r;
+  r.engine.snapshots = true;
+  r.config.snapshot_interval_us = 1000000;
+  r.make();
+  for (int k = 0; k < 25; ++k) r.scan_between_odometry(100U * static_cast<std::uint32_t>(2 * k), 2000000 + 200000LL * k);
+  // 5 s of scans from t = 2 s: the interval ends at t = 2, 3, 4, 5 and 6 s (the first
+  // before any scan: nothing to write then).
+  const std::size_t while_mapping = r.engine.saved_at.size();
+  CHECK(while_mapping >= 3U && while_mapping <= 5U);
+  CHECK_TRUE(file_exists(snapshot_path(r.config)));
+  // Idle: the scans placed since the last one are saved at the next interval, then
+  // nothing more while no scan comes.
+  for (int k = 0; k < 30; ++k) r.odom(5000U, 8000000 + 200000LL * k);
+  const std::size_t after_idle = r.engine.saved_at.size();
+  LONGS_EQUAL(r.engine.got.size(), r.engine.saved_at.back());
+  CHECK(after_idle <= while_mapping + 1U);
+  for (int k = 0; k < 30; ++k) r.odom(5000U, 14000000 + 200000LL * k);
+  LONGS_EQUAL(after_idle, r.engine.saved_at.size());
+  // A last scan, then the stop: saved before the engine finishes.
+  r.scan_between_odometry(5000U, 21000000);
+  CHECK_TRUE(r.d->finish());
+  LONGS_EQUAL(after_idle + 1U, r.engine.saved_at.size());
+  LONGS_EQUAL(r.engine.got.size(), r.engine.saved_at.back());
+  LONGS_EQUAL(after_idle + 1U, r.d->counters().snapshots_written);
+  STRCMP_CONTAINS("\"snapshots\": {", r.d->status_json().c_str());
+  LONGS_EQUAL(0, temp_files_in(r.config.output_directory));
+}
+
+#ifndef SDPSLAM_TEST_UNDER_EMULATOR  // see tests/sdpslamd/CMakeLists.txt
+// On the robot a forked copy writes it while the loop goes on: the file holds the state
+// of the moment of the fork, and the outcome is collected later.
+TEST(SdpslamdLoop, a_forked_child_writes_the_snapshot_while_the_loop_goes_on) {
+  Rig r;
+  r.engine.snapshots = true;
+  r.config.snapshot_interval_us = 1000000;
+  r.make(true);
+  for (int k = 0; k < 6; ++k) r.scan_between_odometry(100U * static_cast<std::uint32_t>(2 * k), 2000000 + 200000LL * k);
+  // The child saves; the parent's fake engine records nothing (the child's memory is
+  // its own). Its outcome is collected by a later step.
+  LONGS_EQUAL(0, r.engine.saved_at.size());
+  for (int i = 0; i < 500 && r.d->counters().snapshots_written == 0U; ++i) {
+    ::usleep(10000);
+    r.d->step();
+  }
+  LONGS_EQUAL(1, r.d->counters().snapshots_written);
+  LONGS_EQUAL(0, r.d->counters().snapshot_failures);
+  auto saved_scans = [&] {
+    std::ifstream in(snapshot_path(r.config));
+    std::size_t n = 0U;
+    in >> n;
+    return n;
+  };
+  const std::size_t forked = saved_scans();
+  CHECK(forked >= 1U && forked <= r.engine.got.size());
+  // Finishing waits for any child, then writes the last one in the loop.
+  r.scan_between_odometry(2000U, 4000000);
+  CHECK_TRUE(r.d->finish());
+  LONGS_EQUAL(1, r.engine.saved_at.size());
+  LONGS_EQUAL(r.engine.got.size(), saved_scans());
+  LONGS_EQUAL(0, temp_files_in(r.config.output_directory));
+}
+#endif
+
+// Off ([output] snapshot_interval_s = 0), or a mode without snapshots: none.
+TEST(SdpslamdLoop, no_snapshot_when_they_are_off) {
+  Rig r;
+  r.engine.snapshots = true;
+  r.config.snapshot_interval_us = 0;
+  r.make();
+  for (int k = 0; k < 10; ++k) r.scan_between_odometry(100U * static_cast<std::uint32_t>(2 * k), 2000000 + 500000LL * k);
+  CHECK_TRUE(r.d->finish());
+  LONGS_EQUAL(0, r.engine.saved_at.size());
+  CHECK_FALSE(file_exists(snapshot_path(r.config)));
 }
 
 TEST(SdpslamdLoop, failed_write_keeps_the_previous_file_and_is_counted) {

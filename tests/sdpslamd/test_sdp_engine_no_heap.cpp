@@ -10,6 +10,7 @@
 
 #include "../localization/localizer_world.h"
 #include "alloc_counter.h"
+#include "box_world.h"
 #include "sdpslam/daemon/daemon.h"
 #include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/slam_engine.h"
@@ -19,47 +20,12 @@
 
 using sdpslam::daemon::DaemonConfig;
 
-namespace {
-
-// A 10 m x 6 m box seen from (x, y) looking along +x: 181 beams over 180 degrees.
-void box_scan(double x, double y, std::int64_t stamp_us, sdpslam::RangeScan* s) {
-  s->stamp_us = stamp_us;
-  s->beam_count = 181U;
-  s->geometry.angle_min_rad = static_cast<float>(-M_PI / 2.0);
-  s->geometry.angle_increment_rad = static_cast<float>(M_PI / 180.0);
-  s->geometry.range_min_m = 0.05F;
-  s->geometry.range_max_m = 30.0F;
-  for (std::uint32_t i = 0; i < s->beam_count; ++i) {
-    const double a = static_cast<double>(s->beam_angle_rad(i));
-    const double c = std::cos(a), n = std::sin(a);
-    double t = 1e9;
-    if (c > 1e-9) t = std::fmin(t, (10.0 - x) / c);
-    if (c < -1e-9) t = std::fmin(t, (0.0 - x) / c);
-    if (n > 1e-9) t = std::fmin(t, (6.0 - y) / n);
-    if (n < -1e-9) t = std::fmin(t, (0.0 - y) / n);
-    s->ranges_m[i] = static_cast<float>(t);
-  }
-}
-
-}  // namespace
+using sdpslam::test::box_scan;
 
 TEST_GROUP(SdpEngineNoHeap){};
 
 TEST(SdpEngineNoHeap, process_does_not_allocate_across_segmentations) {
-  DaemonConfig c;
-  c.mode = sdpslam::daemon::SlamMode::kSdp;
-  c.slam.filter.particle_count = 5U;
-  c.slam.filter.update_min_travel_m = 0.1;
-  c.slam.filter.map_width_m = 30.0;
-  c.slam.filter.map_height_m = 30.0;
-  c.sdp.top_particles = 8U;
-  c.sdp.period_scans = 5U;
-  c.sdp.period_travel_m = 0.0;
-  c.sdp.min_segment_scans = 3U;
-  c.sdp.max_levels = 3U;
-  c.sdp.map_tile_capacity = 2000U;
-  c.sdp.map_observation_capacity = 300000U;
-  c.max_trajectory_scans = 200U;
+  const DaemonConfig c = sdpslam::test::small_sdp_config();
   std::string error;
   auto engine = sdpslam::daemon::make_engine(c, &error);
   CHECK_TRUE_TEXT(engine != nullptr, error.c_str());

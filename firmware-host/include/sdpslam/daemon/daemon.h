@@ -21,9 +21,13 @@
 //   6. every output_period_us writes trajectory.txt/.tum, map.pgm/.yaml/.png and status.json
 //      into the output directory, each atomically (a failed write keeps the previous file
 //      and is logged and counted; the next period tries again).
-//   7. pats the watchdog (DaemonIo::watchdog), when there is one.
+//   7. in mode sdp, every [output] snapshot_interval_s writes the whole SLAM state to
+//      <output>/snapshot.sdps (atomically; only when a scan was placed since the last;
+//      by a forked child with DaemonIo::fork_snapshots, one at a time), so that a
+//      restart continues the same map (resume_from_snapshot());
+//   8. pats the watchdog (DaemonIo::watchdog), when there is one.
 // run() steps until *stop becomes non-zero (SIGINT/SIGTERM), places what can still be
-// placed, and writes the final outputs. When *localize becomes non-zero (SIGUSR1) it
+// placed, writes a last snapshot (mode sdp) and the final outputs. When *localize becomes non-zero (SIGUSR1) it
 // switches from mapping to localization on the map just built
 // (switch_to_localization()).
 //
@@ -69,6 +73,11 @@ struct DaemonCounters {
   std::uint64_t output_writes_unchanged = 0U;  // periods with no new scan: nothing rewritten
   std::int64_t max_output_write_us = 0;
   std::int64_t max_odometry_wait_us = 0;     // longest a placed scan waited for odometry
+  std::uint64_t snapshots_written = 0U;
+  std::uint64_t snapshot_failures = 0U;
+  std::uint64_t snapshot_bytes = 0U;         // the last one's file size
+  std::int64_t max_snapshot_write_us = 0;    // the loop's pause (in the loop) or the child's run (forked)
+  std::uint64_t snapshots_skipped_busy = 0U;  // an interval ended while the previous one was still being written
   std::uint64_t scans_dropped() const {
     return scans_skipped_no_odometry + scans_skipped_too_old + scans_skipped_gap + scans_dropped_queue_full;
   }
@@ -93,7 +102,28 @@ struct DaemonIo {
   // Patted at the end of every step(), so that a supervisor restarts a loop that hangs
   // (hal/watchdog.h; on the robot systemd's WatchdogSec=); may be null.
   hal::Watchdog* watchdog = nullptr;
+  // Periodic snapshots are written by a forked copy of the process, so that the loop
+  // goes on while the state is compressed and written (its memory is shared copy-on-write:
+  // only the pages the loop changes meanwhile are duplicated); false writes them in the
+  // loop itself, which then pauses for as long. The last snapshot, at a stop, is always
+  // written in the loop.
+  bool fork_snapshots = false;
 };
+
+// Where the daemon keeps its snapshot: <output directory>/snapshot.sdps.
+std::string snapshot_path(const DaemonConfig& config);
+
+// At start-up: continues the session a snapshot holds, if there is one and the engine
+// has snapshots (mode sdp) and they are on ([output] snapshot_interval_s > 0).
+enum class ResumeOutcome : std::uint8_t {
+  kFresh,    // nothing to resume: no snapshot, or snapshots off or not in this mode
+  kResumed,  // the engine continues the snapshot's session
+  kRefused,  // the snapshot is another version's, another configuration's, or damaged:
+             // it was moved aside (snapshot.sdps.refused) and the engine must be made
+             // anew (it may hold part of the refused state)
+};
+// Logs what happened (Event::kStartup) with the reason of a refusal.
+ResumeOutcome resume_from_snapshot(const DaemonConfig& config, SlamEngine& engine, EventLog& log);
 
 class Daemon {
  public:
@@ -147,6 +177,12 @@ class Daemon {
   void enqueue(std::int64_t now_us);
   void place_scans(std::int64_t now_us, bool final_pass);
   void watch_faults();
+  bool snapshots_on() const;
+  // In the loop, or by a forked child (`may_fork` and DaemonIo::fork_snapshots).
+  void write_snapshot(bool may_fork);
+  // Collects a finished child's outcome; with `wait`, waits for it.
+  void reap_snapshot(bool wait);
+  void snapshot_done(bool ok, const std::string& error, std::uint64_t scans, std::int64_t started_us);
   static LatencyFigures figures(const RingBuffer<std::int32_t, kLatencyWindow>& w, std::int64_t max_us,
                                 std::uint64_t count);
 
@@ -173,6 +209,11 @@ class Daemon {
   bool encoders_started_ = false;
   std::int64_t start_us_ = 0;
   std::int64_t next_output_us_ = 0;
+  std::int64_t next_snapshot_us_ = 0;
+  std::uint64_t snapshot_at_scans_ = 0U;  // scans_placed at the last snapshot (or the resumed one)
+  int snapshot_child_ = 0;                // pid of the child writing one, 0 if none
+  std::uint64_t snapshot_child_scans_ = 0U;
+  std::int64_t snapshot_child_started_us_ = 0;
   std::string last_output_error_;
   // Previous values of watched counters/states.
   hal::RangeSourceHealth seen_health_ = hal::RangeSourceHealth::kStarting;

@@ -86,6 +86,13 @@ struct DaemonConfig {
   std::uint32_t max_trajectory_scans = 200000U;
   bool write_map = true;
   bool input_log = false;                    // stream every scan fed to SLAM to <directory>/input.clf
+  // Mode sdp: the whole SLAM state goes to <directory>/snapshot.sdps this often (and at
+  // a stop), and a start resumes from it (0 = never; snapshot_file.h, Daemon).
+  std::int64_t snapshot_interval_us = 300000000;
+  // Set by load_daemon_config: a hash of the mode, the profile and every key that shapes
+  // the SLAM state ([slam], [sdp], the filter's sections, [output] max_trajectory_scans),
+  // whatever their order in the file. A snapshot resumes only under the same.
+  std::uint64_t slam_fingerprint = 0U;
   // [daemon]
   std::int64_t log_interval_us = 1000000;    // one line per event kind at most this often
   std::int64_t loop_slice_us = 5000;         // longest wait on the laser before CAN is read

@@ -49,6 +49,28 @@ class SlamEngine {
   // before the last trajectory()/map_image(); the periodic outputs never call it, so
   // they do not change what later scans do.
   virtual void finish() {}
+
+  // ---- snapshots (io/snapshot_file.h) -----------------------------------------------
+  // The engine's whole state (the SLAM state and its records of the scans), so that a
+  // restarted daemon continues the same map and trajectory. Only sdp mode has them;
+  // the others return false with *error saying so. `fingerprint` names the options
+  // (DaemonConfig::slam_fingerprint): a snapshot of other options, another version or a
+  // damaged one is refused by resume_snapshot() (false, *error says why), after which
+  // the engine may be unusable: make a new one.
+  virtual bool has_snapshots() const { return false; }
+  virtual bool save_snapshot(const std::string& path, std::uint64_t fingerprint, std::uint64_t* file_bytes,
+                             std::string* error) {
+    (void)path, (void)fingerprint, (void)file_bytes;
+    *error = std::string("mode ") + name() + " has no snapshots";
+    return false;
+  }
+  // On success *scans is the number of scans the snapshot's session had recorded.
+  virtual bool resume_snapshot(const std::string& path, std::uint64_t fingerprint, std::uint64_t* scans,
+                               std::string* error) {
+    (void)path, (void)fingerprint, (void)scans;
+    *error = std::string("mode ") + name() + " has no snapshots";
+    return false;
+  }
 };
 
 // Bytes of the one arena the configured engine carves its state from at create time

@@ -1,0 +1,176 @@
+// sdpslamd's snapshots (SlamEngine::save_snapshot / resume_snapshot, Daemon's
+// resume_from_snapshot): a restarted daemon continues the session it saved, its encoders'
+// odometry starting again from zero; a snapshot of another configuration or a damaged one
+// is moved aside and the map starts anew.
+#include <CppUTest/TestHarness.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "box_world.h"
+#include "sdpslam/daemon/daemon.h"
+#include "sdpslam/daemon/slam_engine.h"
+#include "shared_data.h"
+
+using sdpslam::daemon::DaemonConfig;
+
+namespace {
+
+using sdpslam::test::box_scan;
+
+DaemonConfig sdp_config(const std::string& dir) {
+  DaemonConfig c = sdpslam::test::small_sdp_config();
+  c.output_directory = dir;
+  c.snapshot_interval_us = 1000000;
+  c.slam_fingerprint = 42U;
+  return c;
+}
+
+// The robot at x = 2 + 0.05 k for k < 60, then standing for a moment (the restart), then
+// on along x; `from_zero` gives the odometry as encoders that restart at scan `restart`.
+double truth_x(int k) { return 2.0 + 0.05 * (k < 60 ? k : k - 1); }
+
+struct Run {
+  std::vector<sdpslam::io::StampedPose> trajectory;
+};
+
+void feed(sdpslam::daemon::SlamEngine& e, int from, int to, int restart) {
+  static sdpslam::RangeScan scan;
+  for (int k = from; k < to; ++k) {
+    const double x = truth_x(k);
+    box_scan(x, 3.0, 1000000 + 100000LL * k, &scan);
+    const double odom_x = k >= restart ? x - truth_x(restart) : x - 2.0;
+    const sdpslam::OdometrySample odom{scan.stamp_us, sdpslam::Pose2{odom_x, 0.0, 0.0}};
+    e.process(odom, scan);
+  }
+}
+
+class NullClock final : public sdpslam::hal::MonotonicClock {
+ public:
+  std::int64_t now_us() const override { return 0; }
+};
+
+bool exists(const std::string& p) {
+  std::FILE* f = std::fopen(p.c_str(), "rb");
+  if (f != nullptr) std::fclose(f);
+  return f != nullptr;
+}
+
+}  // namespace
+
+TEST_GROUP(SdpEngineSnapshot){};
+
+// Stopped after 60 scans and started again: the new engine holds the first 60 poses as
+// they were, and the robot's next poses continue from where it stood, although the
+// encoders count from zero again.
+TEST(SdpEngineSnapshot, a_restarted_engine_continues_the_session_from_where_the_robot_stood) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_snapshot");
+  const DaemonConfig c = sdp_config(dir);
+  std::string error;
+  std::vector<sdpslam::io::StampedPose> before;
+  {
+    auto first = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
+    CHECK_TRUE(first->has_snapshots());
+    feed(*first, 0, 60, 1000);
+    before = first->trajectory();
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
+                    error.c_str());
+    CHECK(bytes > 1000U);
+  }
+  auto second = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
+  NullClock clock;
+  std::FILE* log_file = std::tmpfile();
+  sdpslam::daemon::EventLog log(clock, 0, log_file);
+  CHECK_TRUE(sdpslam::daemon::resume_from_snapshot(c, *second, log) == sdpslam::daemon::ResumeOutcome::kResumed);
+  std::fclose(log_file);
+  const std::vector<sdpslam::io::StampedPose> resumed = second->trajectory();
+  LONGS_EQUAL(before.size(), resumed.size());
+  for (std::size_t k = 0; k < before.size(); ++k) {
+    LONGS_EQUAL(before[k].stamp_us, resumed[k].stamp_us);
+    CHECK(before[k].pose.x_m == resumed[k].pose.x_m && before[k].pose.y_m == resumed[k].pose.y_m);
+  }
+  feed(*second, 60, 120, 60);
+  const std::vector<sdpslam::io::StampedPose> after = second->trajectory();
+  LONGS_EQUAL(120, static_cast<long>(after.size()));
+  // The same session uninterrupted (the encoders counting on): the restart changes the
+  // odometry's origin only, which the engine carries over, so the poses agree to
+  // rounding.
+  auto whole = sdpslam::daemon::make_engine(c, &error);
+  feed(*whole, 0, 120, 1000);
+  const std::vector<sdpslam::io::StampedPose> uninterrupted = whole->trajectory();
+  LONGS_EQUAL(uninterrupted.size(), after.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    worst = std::fmax(worst, std::hypot(after[k].pose.x_m - uninterrupted[k].pose.x_m,
+                                        after[k].pose.y_m - uninterrupted[k].pose.y_m));
+  }
+  CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
+  // And the robot went on: the last pose is metres from the one at the restart.
+  CHECK(after.back().pose.x_m - after[60].pose.x_m > 2.0);
+}
+
+// Another configuration's snapshot, or one damaged on the way (a flipped byte), is not
+// read into the engine: it is moved aside, kept for inspection, and the caller starts a
+// new map. No snapshot at all: a fresh start.
+TEST(SdpEngineSnapshot, a_foreign_or_damaged_snapshot_is_kept_aside_and_the_map_starts_anew) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_snapshot_refused");
+  DaemonConfig c = sdp_config(dir);
+  std::string error;
+  NullClock clock;
+  std::FILE* log_file = std::tmpfile();
+  sdpslam::daemon::EventLog log(clock, 0, log_file);
+  const std::string path = sdpslam::daemon::snapshot_path(c);
+  {
+    auto e = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE(sdpslam::daemon::resume_from_snapshot(c, *e, log) == sdpslam::daemon::ResumeOutcome::kFresh);
+    feed(*e, 0, 30, 1000);
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(e->save_snapshot(path, c.slam_fingerprint, &bytes, &error), error.c_str());
+  }
+  {  // other options
+    DaemonConfig other = c;
+    other.slam_fingerprint = 43U;
+    auto e = sdpslam::daemon::make_engine(other, &error);
+    std::uint64_t scans = 0U;
+    CHECK_FALSE(e->resume_snapshot(path, other.slam_fingerprint, &scans, &error));
+    STRCMP_CONTAINS("another configuration", error.c_str());
+    CHECK_TRUE(sdpslam::daemon::resume_from_snapshot(other, *e, log) == sdpslam::daemon::ResumeOutcome::kRefused);
+    CHECK_FALSE(exists(path));
+    CHECK_TRUE(exists(path + ".refused"));
+    CHECK_EQUAL(0, std::rename((path + ".refused").c_str(), path.c_str()));
+  }
+  {  // a byte flipped in the middle
+    std::FILE* f = std::fopen(path.c_str(), "r+b");
+    CHECK(f != nullptr);
+    std::fseek(f, 0, SEEK_END);
+    const long size = std::ftell(f);
+    std::fseek(f, size / 2, SEEK_SET);
+    const int ch = std::fgetc(f);
+    std::fseek(f, size / 2, SEEK_SET);
+    std::fputc(ch ^ 0x10, f);
+    std::fclose(f);
+    auto e = sdpslam::daemon::make_engine(c, &error);
+    std::uint64_t scans = 0U;
+    CHECK_FALSE(e->resume_snapshot(path, c.slam_fingerprint, &scans, &error));
+    STRCMP_CONTAINS("CRC-32 mismatch", error.c_str());
+  }
+  {  // cut short
+    std::FILE* f = std::fopen(path.c_str(), "r+b");
+    std::fseek(f, 0, SEEK_END);
+    const long size = std::ftell(f);
+    std::fclose(f);
+    CHECK_EQUAL(0, ::truncate(path.c_str(), size - 100));
+    auto e = sdpslam::daemon::make_engine(c, &error);
+    std::uint64_t scans = 0U;
+    CHECK_FALSE(e->resume_snapshot(path, c.slam_fingerprint, &scans, &error));
+    STRCMP_CONTAINS("cut short or corrupt", error.c_str());
+  }
+  std::fclose(log_file);
+}
