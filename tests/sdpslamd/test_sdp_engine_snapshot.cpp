@@ -31,13 +31,11 @@ DaemonConfig sdp_config(const std::string& dir) {
 }
 
 // The robot at x = 2 + 0.05 k for k < 60, then standing for a moment (the restart), then
-// on along x; `from_zero` gives the odometry as encoders that restart at scan `restart`.
+// on along x.
 double truth_x(int k) { return 2.0 + 0.05 * (k < 60 ? k : k - 1); }
 
-struct Run {
-  std::vector<sdpslam::io::StampedPose> trajectory;
-};
-
+// Scans `from` .. `to` - 1; the odometry counts from zero again at scan `restart`, as the
+// encoders of a restarted daemon do.
 void feed(sdpslam::daemon::SlamEngine& e, int from, int to, int restart) {
   static sdpslam::RangeScan scan;
   for (int k = from; k < to; ++k) {
