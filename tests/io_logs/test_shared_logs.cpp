@@ -1,5 +1,6 @@
 // The real logs in ../shared/datasets: record counts from its README, exact stamps,
-// a plausible tinySLAM odometry path, and the reader's throughput on intel.clf.
+// a plausible tinySLAM odometry path, and the reader's throughput on intel.clf; and the
+// ROS 1 bag made from aces.clf (../shared/testdata/bags), read as that log.
 #include <CppUTest/TestHarness.h>
 
 #include <algorithm>
@@ -108,3 +109,58 @@ TEST(SharedLogs, intel_streaming_read_throughput) {
                static_cast<long long>(r.lines_read()), records, mb, s, static_cast<double>(r.lines_read()) / s, mb / s);
   CHECK_EQUAL(40557LL, r.lines_read());
 }
+
+// ../shared/testdata/bags/aces.clf2bag.bag was made from ../shared/datasets/aces.clf
+// (its README): scan i of the bag is FLASER line i of the log, stamped 1e9 s + i x 0.1 s.
+#if SDPSLAM_TEST_ROSBAG
+namespace {
+// rosbag_storage allocates process-wide state on its first use (see test_rosbag.cpp): the
+// bag is opened once during static initialisation, before any test.
+const bool kRosbagStaticsAllocated = [] {
+  const std::string bag = sdpslam::test::find_shared("testdata/bags/aces.clf2bag.bag");
+  if (!bag.empty()) {
+    LogReader reader;
+    std::string error;
+    (void)reader.open(bag, LogReaderOptions{}, &error);
+  }
+  return true;
+}();
+}  // namespace
+
+TEST(SharedLogs, the_aces_bag_reads_as_the_aces_log_scan_by_scan) {
+  const LogContents bag = read_shared("testdata/bags/aces.clf2bag.bag");
+  const LogContents clf = read_shared("datasets/aces.clf");
+  CHECK(bag.format == LogFormat::kRosBag);
+  LONGS_EQUAL(0, bag.error_count);
+  LONGS_EQUAL(7374, bag.lasers.size());
+  LONGS_EQUAL(clf.lasers.size(), bag.lasers.size());
+  for (std::size_t i = 0; i < bag.lasers.size(); ++i) {
+    const auto& b = bag.lasers[i];
+    const auto& c = clf.lasers[i];
+    LONGS_EQUAL(1000000000000000LL + static_cast<long long>(i) * 100000LL, b.stamp_us);
+    LONGS_EQUAL(c.scan.beam_count, b.scan.beam_count);
+    // The ranges are the log's, bit for bit; the geometry the same to float precision.
+    CHECK(std::memcmp(c.scan.ranges_m, b.scan.ranges_m, sizeof(float) * c.scan.beam_count) == 0);
+    DOUBLES_EQUAL(c.scan.geometry.angle_min_rad, b.scan.geometry.angle_min_rad, 1e-6);
+    DOUBLES_EQUAL(c.scan.geometry.angle_increment_rad, b.scan.geometry.angle_increment_rad, 1e-7);
+    CHECK_EQUAL(c.scan.geometry.range_max_m, b.scan.geometry.range_max_m);
+    CHECK_TRUE(b.has_odom_pose);
+    // The odometry as the log wrote it, through a quaternion (heading to ~1e-15 rad).
+    DOUBLES_EQUAL(c.odom_pose.x_m, b.odom_pose.x_m, 1e-12);
+    DOUBLES_EQUAL(c.odom_pose.y_m, b.odom_pose.y_m, 1e-12);
+    DOUBLES_EQUAL(0.0, std::remainder(c.odom_pose.heading_rad - b.odom_pose.heading_rad, 2.0 * M_PI), 1e-12);
+    DOUBLES_EQUAL(0.0, b.scan.geometry.laser_in_base.x_m, 0.0);
+    DOUBLES_EQUAL(0.0, b.scan.geometry.laser_in_base.heading_rad, 0.0);
+  }
+}
+#else
+// A build without ROS bag support recognises the bag and says what it lacks.
+TEST(SharedLogs, the_aces_bag_is_refused_with_what_to_install) {
+  LogContents c;
+  std::string error;
+  CHECK_FALSE(sdpslam::io::read_whole_log(sdpslam::test::shared_path("testdata/bags/aces.clf2bag.bag"),
+                                          LogReaderOptions{}, &c, &error));
+  CHECK_TEXT(error.find("without ROS bag support") != std::string::npos, error.c_str());
+  CHECK_TEXT(error.find("librosbag-storage-dev") != std::string::npos, error.c_str());
+}
+#endif

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "sdpslam/io/figures.h"
+#include "sdpslam/io/log_reader.h"
 
 namespace sdpslam::cli {
 
@@ -82,5 +83,23 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };
+
+// ROS bag input (io/log_reader.h, LogReaderOptions::bag_*): the topics a bag is read
+// through, for every command that reads a log.
+struct BagTopics {
+  std::string scan_topic;
+  std::string odom_topic;
+  void apply(io::LogReaderOptions* o) const {
+    o->bag_scan_topic = scan_topic;
+    o->bag_odom_topic = odom_topic;
+  }
+};
+inline void add_bag_options(CLI::App& app, BagTopics* t) {
+  app.add_option("--scan-topic", t->scan_topic,
+                 "ROS bag: the sensor_msgs/LaserScan topic (default: the bag's only one, or /scan)");
+  app.add_option("--odom-topic", t->odom_topic,
+                 "ROS bag: the nav_msgs/Odometry topic (default: the bag's only one, or /odom; with none, the "
+                 "odom -> base_link transforms on /tf)");
+}
 
 }  // namespace sdpslam::cli

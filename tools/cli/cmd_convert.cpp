@@ -1,5 +1,5 @@
-// `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz)
-// to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
+// `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz;
+// ROS 1 bags) to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
 // skipped and listed ("file:line: reason"); an input with no scan and no odometry left
 // is refused (exit 3) and OUT is not written.
 
@@ -22,15 +22,18 @@ struct ConvertArgs {
   std::string out;
   std::string format = "auto";
   io::WheelOdometryParams wheels;
+  BagTopics bag;
 };
 
 int run_convert(const ConvertArgs& a) {
   io::LogReaderOptions options;
   options.wheels = a.wheels;
   options.max_errors_kept = kErrorsPrinted;
+  a.bag.apply(&options);
   if (a.format == "carmen") options.format = io::LogFormat::kCarmen;
   if (a.format == "tinyslam") options.format = io::LogFormat::kTinySlam;
   if (a.format == "dpslam") options.format = io::LogFormat::kDpSlam;
+  if (a.format == "rosbag") options.format = io::LogFormat::kRosBag;
 
   io::LogReader reader;
   std::string error;
@@ -49,8 +52,8 @@ int run_convert(const ConvertArgs& a) {
   std::uint64_t lasers = 0;
   std::uint64_t odoms = 0;
   std::uint64_t params = 0;
-  // Formats without ODOM lines (tinySLAM) get one per scan from the scan's odometry pose.
-  const bool synth_odom = reader.format() == io::LogFormat::kTinySlam;
+  // Formats without ODOM lines (tinySLAM, ROS bags) get one per scan from the scan's odometry pose.
+  const bool synth_odom = reader.format() == io::LogFormat::kTinySlam || reader.format() == io::LogFormat::kRosBag;
   for (;;) {
     const io::LogReader::Next n = reader.next();
     if (n == io::LogReader::Next::kEnd) break;
@@ -91,10 +94,13 @@ int run_convert(const ConvertArgs& a) {
     std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
     return kExitIo;
   }
-  std::printf("converted %s (%s): %llu scans, %llu odometry, %llu params from %lld lines -> %s\n", a.in.c_str(),
-              io::to_string(reader.format()), static_cast<unsigned long long>(lasers),
-              static_cast<unsigned long long>(odoms), static_cast<unsigned long long>(params),
-              static_cast<long long>(reader.lines_read()), a.out.c_str());
+  // A bag's "lines" are its scan messages (LogReader::lines_read()); it names its topics.
+  const bool bag = reader.format() == io::LogFormat::kRosBag;
+  std::printf("converted %s (%s%s%s): %llu scans, %llu odometry, %llu params from %lld %s -> %s\n", a.in.c_str(),
+              io::to_string(reader.format()), bag ? ": " : "", bag ? reader.source_description().c_str() : "",
+              static_cast<unsigned long long>(lasers), static_cast<unsigned long long>(odoms),
+              static_cast<unsigned long long>(params), static_cast<long long>(reader.lines_read()),
+              bag ? "scan messages" : "lines", a.out.c_str());
   if (reader.error_count() > 0) {
     std::fprintf(stderr, "warning: %zu input lines skipped (%zu of them unknown message types)\n",
                  reader.error_count(), reader.warning_count());
@@ -104,11 +110,11 @@ int run_convert(const ConvertArgs& a) {
 
 std::function<int()> setup_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted)")->required();
+  app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted; ROS 1 .bag)")->required();
   app.add_option("OUT", args->out, "output CARMEN log (written atomically)")->required();
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   app.add_option("--format", args->format, "input format")
-      ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam"}))
+      ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam", "rosbag"}))
       ->capture_default_str();
   app.add_option("--ticks-per-rev", args->wheels.ticks_per_rev, "encoder ticks per wheel revolution (tinySLAM)")
       ->check(CLI::PositiveNumber)
@@ -119,12 +125,13 @@ std::function<int()> setup_convert(CLI::App& app) {
   app.add_option("--wheel-separation", args->wheels.wheel_separation_m, "distance between the wheels, m (tinySLAM)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  add_bag_options(app, &args->bag);
   return [args] { return run_convert(*args); };
 }
 
 }  // namespace
 
-SDPSLAM_REGISTER_COMMAND(convert, "convert", "convert a robot log (CARMEN, tinySLAM, DP-SLAM) to a CARMEN log", 20,
+SDPSLAM_REGISTER_COMMAND(convert, "convert", "convert a robot log (CARMEN, tinySLAM, DP-SLAM, ROS 1 bag) to a CARMEN log", 20,
                          setup_convert);
 
 }  // namespace sdpslam::cli

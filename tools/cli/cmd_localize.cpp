@@ -20,12 +20,14 @@ struct LocalizeArgs {
   std::uint32_t min_particles = 0U;
   std::uint32_t max_particles = 0U;
   bool quiet = false;
+  BagTopics bag;
 };
 
 int run_localize_command(const LocalizeArgs& a) {
   slam::LocalizeRunOptions o;
   o.seed = a.seed;
   o.skip_scans = a.skip_scans;
+  a.bag.apply(&o.log);
   if (a.min_particles != 0U) o.localizer.min_particles = a.min_particles;
   if (a.max_particles != 0U) o.localizer.max_particles = a.max_particles;
   if (!a.start.empty()) {
@@ -78,6 +80,7 @@ std::function<int()> setup_localize(CLI::App& app) {
   app.add_option("--max-particles", args->max_particles, "KLD-sampling's ceiling and memory (default 20000)")
       ->check(whole_number(1000000U));
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)")->check(whole_number(UINT64_MAX));
+  add_bag_options(app, &args->bag);
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args] { return run_localize_command(*args); };
 }

@@ -40,6 +40,7 @@ struct RunArgs {
   std::string snapshot;
   double snapshot_every_s = 0.0;
   std::string resume;
+  BagTopics bag;
 };
 
 // What sets the options of a run, for snapshots (io/snapshot_file.h): the mode, the
@@ -48,7 +49,8 @@ struct RunArgs {
 std::uint64_t config_fingerprint(const RunArgs& a, SdpProfile profile, std::string* error) {
   std::string text = "mode=" + a.mode + "\nprofile=" + to_string(profile) + "\nparticles=" +
                      std::to_string(a.particles) + "\ntop_particles=" + std::to_string(a.top_particles) +
-                     "\ntopology=" + a.topology + "\nconfig:\n";
+                     "\ntopology=" + a.topology + "\nscan_topic=" + a.bag.scan_topic +
+                     "\nodom_topic=" + a.bag.odom_topic + "\nconfig:\n";
   if (!a.config.empty()) {
     std::FILE* f = std::fopen(a.config.c_str(), "rb");
     if (f == nullptr) {
@@ -232,7 +234,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
 
 std::function<int()> setup_run(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
-  app.add_option("log", args->log, "Robot log (CARMEN .clf[.gz], tinySLAM .dat, DP-SLAM .log)")->required();
+  app.add_option("log", args->log, "Robot log (CARMEN .clf[.gz], tinySLAM .dat, DP-SLAM .log, ROS 1 .bag)")->required();
   app.add_option("--mode", args->mode,
                  "Algorithm: sdp (Segmented DP-SLAM, default) or dpslam (the bottom-level DP-SLAM filter alone)")
       ->check(CLI::IsMember({"sdp", "dpslam"}))
@@ -266,6 +268,7 @@ std::function<int()> setup_run(CLI::App& app) {
   app.add_option("--resume", args->resume,
                  "sdp: continue the run a --snapshot file holds, on the same log with the same options (the scans "
                  "it holds are not processed again; the outputs are those of an uninterrupted run)");
+  add_bag_options(app, &args->bag);
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
@@ -291,6 +294,7 @@ std::function<int()> setup_run(CLI::App& app) {
     if (!args->config.empty() && !slam::load_config_ini(args->config, &config, &error)) {
       return report("", kExitBadInput, error);
     }
+    args->bag.apply(&config.log);
     if (!sdp && !args->config.empty() && ini_has_section(args->config, "sdp")) {
       std::fprintf(stderr, "sdpslam run: warning: %s: [sdp] keys have no effect in --mode dpslam\n",
                    args->config.c_str());

@@ -1,9 +1,19 @@
 #include <cstdio>
+#include <fstream>
 #include <string>
 
+#include "rosbag_source.h"
 #include "sdpslam/io/log_reader.h"
 
 namespace sdpslam::io {
+
+bool detail::looks_like_rosbag(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  char magic[13] = {};
+  f.read(magic, sizeof magic);
+  return f.gcount() == static_cast<std::streamsize>(sizeof magic) &&
+         std::string(magic, sizeof magic) == "#ROSBAG V2.0\n";
+}
 
 const char* to_string(LogFormat f) {
   switch (f) {
@@ -11,6 +21,7 @@ const char* to_string(LogFormat f) {
     case LogFormat::kCarmen: return "carmen";
     case LogFormat::kTinySlam: return "tinyslam";
     case LogFormat::kDpSlam: return "dpslam";
+    case LogFormat::kRosBag: return "rosbag";
   }
   return "unknown";
 }

@@ -14,6 +14,7 @@
 
 #include "carmen_parse.h"
 #include "log_parse.h"
+#include "rosbag_source.h"
 #include "sdpslam/io/log_reader.h"
 #include "sdpslam/core/det_math.h"
 
@@ -160,6 +161,7 @@ struct LogReader::Impl {
   LogReaderOptions options;
   std::string path;
   LineSource source;
+  std::unique_ptr<detail::RosBagSource> bag;  // format kRosBag
   LogFormat format = LogFormat::kAuto;
   std::string line;
   std::vector<std::string_view> fields;
@@ -495,6 +497,12 @@ bool LogReader::open(const std::string& path, const LogReaderOptions& options, s
   std::string local_error;
   std::string* err = error != nullptr ? error : &local_error;
   LogFormat format = options.format;
+  if (format == LogFormat::kRosBag || (format == LogFormat::kAuto && detail::looks_like_rosbag(path))) {
+    impl_->bag = std::make_unique<detail::RosBagSource>();
+    if (!impl_->bag->open(path, options, err)) return false;
+    impl_->format = LogFormat::kRosBag;
+    return true;
+  }
   if (format == LogFormat::kAuto) {
     // A first pass over the head of the file; the first line that names a format decides.
     constexpr int kDetectLines = 100;
@@ -523,6 +531,18 @@ bool LogReader::open(const std::string& path, const LogReaderOptions& options, s
 LogReader::Next LogReader::next() {
   Impl& s = *impl_;
   if (s.format == LogFormat::kAuto) return Next::kEnd;  // not open
+  if (s.format == LogFormat::kRosBag) {
+    for (;;) {
+      bool warning = false;
+      const detail::RosBagSource::Got got = s.bag->next(&s.laser, &s.reason, &warning, &s.line_no);
+      if (got == detail::RosBagSource::Got::kEnd) return Next::kEnd;
+      if (!s.reason.empty()) s.add_error(s.line_no, s.reason, warning);
+      if (got == detail::RosBagSource::Got::kSkipped) continue;
+      s.sequence_record(Next::kLaser);
+      s.laser.line = s.line_no;
+      return Next::kLaser;
+    }
+  }
   bool overlong = false;
   while (s.source.next(&s.line, &overlong)) {
     ++s.line_no;
@@ -545,7 +565,8 @@ LogReader::Next LogReader::next() {
         break;
       case LogFormat::kTinySlam: got = s.parse_tinyslam(); break;
       case LogFormat::kDpSlam: got = s.parse_dpslam(); break;
-      case LogFormat::kAuto: break;
+      case LogFormat::kAuto:
+      case LogFormat::kRosBag: break;
     }
     if (!s.reason.empty()) {
       const bool warning = s.reason.rfind(detail::kUnknownTypePrefix, 0) == 0;
@@ -585,7 +606,12 @@ std::size_t LogReader::odometry_jumps_removed() const { return impl_->jumps_remo
 std::size_t LogReader::scans_stamped_backwards() const { return impl_->stamps_backwards; }
 std::int64_t LogReader::first_backwards_line() const { return impl_->first_backwards_line; }
 std::int64_t LogReader::lines_read() const { return impl_->line_no; }
-std::uint64_t LogReader::input_offset() const { return impl_->source.offset(); }
+std::uint64_t LogReader::input_offset() const {
+  return impl_->bag != nullptr ? impl_->bag->offset() : impl_->source.offset();
+}
+std::string LogReader::source_description() const {
+  return impl_->bag != nullptr ? impl_->bag->description() : std::string();
+}
 
 bool read_whole_log(const std::string& path, const LogReaderOptions& options, LogContents* out, std::string* error) {
   *out = LogContents{};

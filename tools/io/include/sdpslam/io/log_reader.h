@@ -23,6 +23,7 @@ enum class LogFormat {
   kCarmen,
   kTinySlam,
   kDpSlam,
+  kRosBag,    // a ROS 1 bag (format 2.0): LaserScan + Odometry or /tf (rosbag_source.h)
 };
 
 const char* to_string(LogFormat f);
@@ -110,6 +111,15 @@ struct LogReaderOptions {
   // Checked where the log has real timestamps; 0 = not checked.
   double max_speed_mps = 5.0;
   double max_turn_rate_radps = 10.0;
+  // ROS 1 bags: the sensor_msgs/LaserScan topic and the nav_msgs/Odometry topic (empty:
+  // the bag's only one, or /scan and /odom among several); without an Odometry topic the
+  // odom_frame -> base_frame transforms of /tf are the odometry. The laser's mounting is
+  // the /tf_static chain from the base frame (the Odometry's child_frame_id, else
+  // base_frame) to the scan's frame_id.
+  std::string bag_scan_topic;
+  std::string bag_odom_topic;
+  std::string bag_odom_frame = "odom";
+  std::string bag_base_frame = "base_link";
 };
 
 class LogReader {
@@ -171,6 +181,9 @@ class LogReader {
   std::int64_t lines_read() const;
   // Bytes of the input file consumed so far (compressed bytes for .gz), for progress.
   std::uint64_t input_offset() const;
+  // For a ROS bag: the topics and frames it is read through ("scan /scan, odometry
+  // /odom, base frame base_link"); empty for text logs.
+  std::string source_description() const;
 
  private:
   struct Impl;

@@ -1,0 +1,22 @@
+// A build without ROS 1 bag support (tools/io/CMakeLists.txt: the ROS packages were not
+// found): bags are recognised and refused with what to install.
+#include "rosbag_source.h"
+
+namespace sdpslam::io::detail {
+
+struct RosBagSource::Impl {};
+
+RosBagSource::RosBagSource() = default;
+RosBagSource::~RosBagSource() = default;
+
+bool RosBagSource::open(const std::string& path, const LogReaderOptions&, std::string* error) {
+  *error = path + ": a ROS 1 bag, and this sdpslam was built without ROS bag support (Debian: "
+                  "librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev, then configure again)";
+  return false;
+}
+
+RosBagSource::Got RosBagSource::next(LaserRecord*, std::string*, bool*, std::int64_t*) { return Got::kEnd; }
+std::uint64_t RosBagSource::offset() const { return 0U; }
+std::string RosBagSource::description() const { return std::string(); }
+
+}  // namespace sdpslam::io::detail
