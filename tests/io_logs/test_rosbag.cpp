@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "sdpslam/io/bags.h"
 #include "sdpslam/io/log_reader.h"
 #include "shared_data.h"
 #include "sdpslam/core/capacities.h"
@@ -26,6 +27,11 @@ using sdpslam::io::LogReader;
 using sdpslam::io::LogReaderOptions;
 
 namespace {
+
+const bool kBagsEnabled = [] {
+  sdpslam::io::enable_bag_formats();
+  return true;
+}();
 
 // rosbag_storage keeps process-wide state allocated on its first use (its encryptor
 // plugin loader's registries: some 500 blocks, reachable until exit, so no leak to the

@@ -1,16 +1,20 @@
 // The real logs in ../shared/datasets: record counts from its README, exact stamps,
 // a plausible tinySLAM odometry path, and the reader's throughput on intel.clf; and the
-// ROS 1 bag made from aces.clf (../shared/testdata/bags), read as that log.
+// ROS 1 bag made from aces.clf (../shared/testdata/bags), read as that log; and aces.clf
+// written as a ROS 2 bag and read back.
 #include <CppUTest/TestHarness.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "shared_data.h"
 #include "sdpslam/io/log_reader.h"
+#include "sdpslam/io/bags.h"
+#include "yaml_statics.h"  // reading a ROS 2 bag folder reads its metadata.yaml
 
 using sdpslam::io::LogContents;
 using sdpslam::io::LogFormat;
@@ -18,6 +22,12 @@ using sdpslam::io::LogReader;
 using sdpslam::io::LogReaderOptions;
 
 namespace {
+
+const bool kBagsEnabled = [] {
+  sdpslam::io::enable_bag_formats();
+  return true;
+}();
+
 LogContents read_shared(const std::string& name) {
   LogContents c;
   std::string error;
@@ -162,5 +172,37 @@ TEST(SharedLogs, the_aces_bag_is_refused_with_what_to_install) {
                                           LogReaderOptions{}, &c, &error));
   CHECK_TEXT(error.find("without ROS bag support") != std::string::npos, error.c_str());
   CHECK_TEXT(error.find("librosbag-storage-dev") != std::string::npos, error.c_str());
+}
+#endif
+
+#if SDPSLAM_TEST_ROS2BAG
+TEST(SharedLogs, aces_written_as_a_ros2_bag_reads_back_as_the_log) {
+  const std::string dir = sdpslam::test::make_temp_dir("aces-ros2");
+  const LogContents clf = read_shared("datasets/aces.clf");
+  {
+    sdpslam::io::Ros2BagWriter w;
+    std::string error;
+    CHECK_TEXT(w.open(dir + "/aces", &error), error.c_str());
+    for (const auto& l : clf.lasers) CHECK_TEXT(w.laser(l, &error), error.c_str());
+    CHECK_TEXT(w.close(&error), error.c_str());
+  }
+  LogContents bag;
+  std::string error;
+  CHECK_TEXT(sdpslam::io::read_whole_log(dir + "/aces", LogReaderOptions{}, &bag, &error), error.c_str());
+  CHECK(bag.format == LogFormat::kRos2Bag);
+  LONGS_EQUAL(0, bag.error_count);
+  LONGS_EQUAL(clf.lasers.size(), bag.lasers.size());
+  for (std::size_t i = 0; i < bag.lasers.size(); ++i) {
+    const auto& b = bag.lasers[i];
+    const auto& c = clf.lasers[i];
+    LONGS_EQUAL(c.stamp_us, b.stamp_us);
+    LONGS_EQUAL(c.scan.beam_count, b.scan.beam_count);
+    CHECK(std::memcmp(c.scan.ranges_m, b.scan.ranges_m, sizeof(float) * c.scan.beam_count) == 0);
+    CHECK(std::memcmp(&c.scan.geometry, &b.scan.geometry, sizeof c.scan.geometry) == 0);
+    CHECK_TRUE(b.has_odom_pose);
+    DOUBLES_EQUAL(c.odom_pose.x_m, b.odom_pose.x_m, 0.0);
+    DOUBLES_EQUAL(c.odom_pose.y_m, b.odom_pose.y_m, 0.0);
+    DOUBLES_EQUAL(0.0, std::remainder(c.odom_pose.heading_rad - b.odom_pose.heading_rad, 2.0 * M_PI), 1e-15);
+  }
 }
 #endif

@@ -35,7 +35,8 @@ CLI::Validator non_empty();
 // bars; tools/plot), or io::plain_painter() in a build without cairo.
 io::Painter figure_painter();
 
-// Size of a file in KiB (0 when it cannot be read), a progress total.
+// Size of a file in KiB (of a folder's files for a folder; 0 when it cannot be read), a
+// progress total.
 std::uint64_t file_size_kib(const std::string& path);
 
 // Skipped log lines named on stderr, of each kind (malformed, skipped on purpose), before

@@ -1,5 +1,6 @@
 // `sdpslam convert IN OUT`: any supported log (CARMEN, tinySLAM, DP-SLAM, optionally .gz;
-// ROS 1 bags) to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines. Malformed input lines are
+// ROS 1 and ROS 2 bags) to a CARMEN log of ODOM and FLASER/ROBOTLASER1 lines, or with
+// `--to ros2` to a ROS 2 bag (io/bags.h). Malformed input lines are
 // skipped and listed ("file:line: reason"); an input with no scan and no odometry left
 // is refused (exit 3) and OUT is not written.
 
@@ -10,6 +11,7 @@
 #include "cli_common.h"
 #include "sdpslam/io/carmen_writer.h"
 #include "sdpslam/io/log_reader.h"
+#include "sdpslam/io/bags.h"
 
 namespace sdpslam::cli {
 namespace {
@@ -21,9 +23,49 @@ struct ConvertArgs {
   bool quiet = false;
   std::string out;
   std::string format = "auto";
+  std::string to = "carmen";
   io::WheelOdometryParams wheels;
   BagTopics bag;
 };
+
+// `--to ros2`: a rosbag2 folder (io/bags.h); the log's odometry records only pair
+// with its scans, whose odometry the bag carries.
+int convert_to_ros2(const ConvertArgs& a, io::LogReader& reader) {
+  io::Ros2BagWriter writer;
+  std::string error;
+  if (!writer.open(a.out, &error)) {
+    std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+    return io::ros2_bags_supported() ? kExitIo : kExitUsage;
+  }
+  Progress progress("KiB", file_size_kib(a.in), a.quiet);
+  for (;;) {
+    const io::LogReader::Next n = reader.next();
+    if (n == io::LogReader::Next::kEnd) break;
+    if (n == io::LogReader::Next::kOdom) writer.odom(reader.odom());
+    if (n == io::LogReader::Next::kLaser) {
+      if (!writer.laser(reader.laser(), &error)) {
+        std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+        return kExitIo;
+      }
+    }
+    progress.update(reader.input_offset() / 1024U);
+  }
+  progress.finish();
+  io::write_log_errors(stderr, reader.errors(), reader.error_count(), kLogErrorsShown);
+  if (writer.scans_written() == 0U) {
+    std::fprintf(stderr, "sdpslam convert: %s: no laser scan with odometry in it: nothing to convert\n",
+                 a.in.c_str());
+    return kExitBadInput;  // the writer abandons its folder
+  }
+  if (!writer.close(&error)) {
+    std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
+    return kExitIo;
+  }
+  std::printf("converted %s (%s): %llu scans (%llu before any odometry, left out) -> ROS 2 bag %s\n", a.in.c_str(),
+              io::to_string(reader.format()), static_cast<unsigned long long>(writer.scans_written()),
+              static_cast<unsigned long long>(writer.scans_without_odometry()), a.out.c_str());
+  return kExitOk;
+}
 
 int run_convert(const ConvertArgs& a) {
   io::LogReaderOptions options;
@@ -34,6 +76,7 @@ int run_convert(const ConvertArgs& a) {
   if (a.format == "tinyslam") options.format = io::LogFormat::kTinySlam;
   if (a.format == "dpslam") options.format = io::LogFormat::kDpSlam;
   if (a.format == "rosbag") options.format = io::LogFormat::kRosBag;
+  if (a.format == "ros2bag") options.format = io::LogFormat::kRos2Bag;
 
   io::LogReader reader;
   std::string error;
@@ -41,6 +84,7 @@ int run_convert(const ConvertArgs& a) {
     std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
     return kExitBadInput;
   }
+  if (a.to == "ros2") return convert_to_ros2(a, reader);
   io::CarmenWriter writer;
   if (!writer.open(a.out, &error)) {
     std::fprintf(stderr, "sdpslam convert: %s\n", error.c_str());
@@ -53,7 +97,8 @@ int run_convert(const ConvertArgs& a) {
   std::uint64_t odoms = 0;
   std::uint64_t params = 0;
   // Formats without ODOM lines (tinySLAM, ROS bags) get one per scan from the scan's odometry pose.
-  const bool synth_odom = reader.format() == io::LogFormat::kTinySlam || reader.format() == io::LogFormat::kRosBag;
+  const bool synth_odom = reader.format() == io::LogFormat::kTinySlam || reader.format() == io::LogFormat::kRosBag ||
+                          reader.format() == io::LogFormat::kRos2Bag;
   for (;;) {
     const io::LogReader::Next n = reader.next();
     if (n == io::LogReader::Next::kEnd) break;
@@ -95,7 +140,7 @@ int run_convert(const ConvertArgs& a) {
     return kExitIo;
   }
   // A bag's "lines" are its scan messages (LogReader::lines_read()); it names its topics.
-  const bool bag = reader.format() == io::LogFormat::kRosBag;
+  const bool bag = reader.format() == io::LogFormat::kRosBag || reader.format() == io::LogFormat::kRos2Bag;
   std::printf("converted %s (%s%s%s): %llu scans, %llu odometry, %llu params from %lld %s -> %s\n", a.in.c_str(),
               io::to_string(reader.format()), bag ? ": " : "", bag ? reader.source_description().c_str() : "",
               static_cast<unsigned long long>(lasers), static_cast<unsigned long long>(odoms),
@@ -110,11 +155,16 @@ int run_convert(const ConvertArgs& a) {
 
 std::function<int()> setup_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
-  app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted; ROS 1 .bag)")->required();
+  app.add_option("IN", args->in, "input log (.clf, tinySLAM .dat, DP-SLAM .log; .gz accepted; ROS 1 .bag; ROS 2 bag folder or .db3)")->required();
   app.add_option("OUT", args->out, "output CARMEN log (written atomically)")->required();
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   app.add_option("--format", args->format, "input format")
-      ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam", "rosbag"}))
+      ->check(CLI::IsMember({"auto", "carmen", "tinyslam", "dpslam", "rosbag", "ros2bag"}))
+      ->capture_default_str();
+  app.add_option("--to", args->to,
+                 "output: carmen (a CARMEN log file) or ros2 (a rosbag2 folder: /scan, /odom, /tf, /tf_static; "
+                 "SQLite storage, CDR)")
+      ->check(CLI::IsMember({"carmen", "ros2"}))
       ->capture_default_str();
   app.add_option("--ticks-per-rev", args->wheels.ticks_per_rev, "encoder ticks per wheel revolution (tinySLAM)")
       ->check(CLI::PositiveNumber)
@@ -131,7 +181,7 @@ std::function<int()> setup_convert(CLI::App& app) {
 
 }  // namespace
 
-SDPSLAM_REGISTER_COMMAND(convert, "convert", "convert a robot log (CARMEN, tinySLAM, DP-SLAM, ROS 1 bag) to a CARMEN log", 20,
+SDPSLAM_REGISTER_COMMAND(convert, "convert", "convert a robot log (CARMEN, tinySLAM, DP-SLAM, ROS 1 or 2 bag) to a CARMEN log or a ROS 2 bag", 20,
                          setup_convert);
 
 }  // namespace sdpslam::cli

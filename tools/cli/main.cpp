@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <exception>
 #include <new>
 #include <string>
 #include <vector>
 
+#include "sdpslam/io/bags.h"
 #include "cli_common.h"
 #include "sdpslam/core/version.h"
 
@@ -49,6 +51,14 @@ CLI::Validator non_empty() {
 }
 
 std::uint64_t file_size_kib(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {  // a ROS 2 bag: its files together
+    std::uint64_t bytes = 0U;
+    for (const auto& e : std::filesystem::directory_iterator(path, ec)) {
+      if (e.is_regular_file(ec)) bytes += static_cast<std::uint64_t>(e.file_size(ec));
+    }
+    return bytes / 1024U;
+  }
   struct stat st {};
   return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) / 1024U : 0U;
 }
@@ -89,6 +99,7 @@ void Progress::finish() {
 
 int main(int argc, char** argv) {
   using namespace sdpslam::cli;
+  sdpslam::io::enable_bag_formats();  // every command that reads a log reads ROS bags too
   CLI::App app{"sdpslam: Segmented DP-SLAM for wheeled robots (simulate, convert, evaluate, run)"};
   app.set_version_flag("--version", sdpslam::version_string());
   app.require_subcommand(1);

@@ -1,11 +1,16 @@
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
-#include "rosbag_source.h"
+#include "bag_common.h"
 #include "sdpslam/io/log_reader.h"
 
 namespace sdpslam::io {
+
+detail::BagSourceMaker detail::g_make_ros1_source = nullptr;
+detail::BagSourceMaker detail::g_make_ros2_source = nullptr;
 
 bool detail::looks_like_rosbag(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -15,6 +20,22 @@ bool detail::looks_like_rosbag(const std::string& path) {
          std::string(magic, sizeof magic) == "#ROSBAG V2.0\n";
 }
 
+bool detail::looks_like_ros2_bag(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    if (fs::exists(fs::path(path) / "metadata.yaml", ec)) return true;
+    for (const auto& e : fs::directory_iterator(path, ec)) {
+      if (e.path().extension() == ".db3") return true;
+    }
+    return false;
+  }
+  std::ifstream f(path, std::ios::binary);
+  char magic[16] = {};
+  f.read(magic, sizeof magic);
+  return f.gcount() == static_cast<std::streamsize>(sizeof magic) && std::memcmp(magic, "SQLite format 3", 16) == 0;
+}
+
 const char* to_string(LogFormat f) {
   switch (f) {
     case LogFormat::kAuto: return "auto";
@@ -22,6 +43,7 @@ const char* to_string(LogFormat f) {
     case LogFormat::kTinySlam: return "tinyslam";
     case LogFormat::kDpSlam: return "dpslam";
     case LogFormat::kRosBag: return "rosbag";
+    case LogFormat::kRos2Bag: return "ros2bag";
   }
   return "unknown";
 }

@@ -14,7 +14,7 @@
 
 #include "carmen_parse.h"
 #include "log_parse.h"
-#include "rosbag_source.h"
+#include "bag_common.h"
 #include "sdpslam/io/log_reader.h"
 #include "sdpslam/core/det_math.h"
 
@@ -161,7 +161,7 @@ struct LogReader::Impl {
   LogReaderOptions options;
   std::string path;
   LineSource source;
-  std::unique_ptr<detail::RosBagSource> bag;  // format kRosBag
+  std::unique_ptr<detail::BagSource> bag;  // formats kRosBag, kRos2Bag
   LogFormat format = LogFormat::kAuto;
   std::string line;
   std::vector<std::string_view> fields;
@@ -497,10 +497,19 @@ bool LogReader::open(const std::string& path, const LogReaderOptions& options, s
   std::string local_error;
   std::string* err = error != nullptr ? error : &local_error;
   LogFormat format = options.format;
-  if (format == LogFormat::kRosBag || (format == LogFormat::kAuto && detail::looks_like_rosbag(path))) {
-    impl_->bag = std::make_unique<detail::RosBagSource>();
+  if (format == LogFormat::kAuto && detail::looks_like_rosbag(path)) format = LogFormat::kRosBag;
+  if (format == LogFormat::kAuto && detail::looks_like_ros2_bag(path)) format = LogFormat::kRos2Bag;
+  if (format == LogFormat::kRosBag || format == LogFormat::kRos2Bag) {
+    const detail::BagSourceMaker make =
+        format == LogFormat::kRosBag ? detail::g_make_ros1_source : detail::g_make_ros2_source;
+    if (make == nullptr) {
+      *err = path + ": a " + (format == LogFormat::kRosBag ? "ROS 1" : "ROS 2") +
+             " bag, and this program reads no bags (the sdpslam command does)";
+      return false;
+    }
+    impl_->bag = make();
     if (!impl_->bag->open(path, options, err)) return false;
-    impl_->format = LogFormat::kRosBag;
+    impl_->format = format;
     return true;
   }
   if (format == LogFormat::kAuto) {
@@ -531,13 +540,13 @@ bool LogReader::open(const std::string& path, const LogReaderOptions& options, s
 LogReader::Next LogReader::next() {
   Impl& s = *impl_;
   if (s.format == LogFormat::kAuto) return Next::kEnd;  // not open
-  if (s.format == LogFormat::kRosBag) {
+  if (s.bag != nullptr) {
     for (;;) {
       bool warning = false;
-      const detail::RosBagSource::Got got = s.bag->next(&s.laser, &s.reason, &warning, &s.line_no);
-      if (got == detail::RosBagSource::Got::kEnd) return Next::kEnd;
+      const detail::BagSource::Got got = s.bag->next(&s.laser, &s.reason, &warning, &s.line_no);
+      if (got == detail::BagSource::Got::kEnd) return Next::kEnd;
       if (!s.reason.empty()) s.add_error(s.line_no, s.reason, warning);
-      if (got == detail::RosBagSource::Got::kSkipped) continue;
+      if (got == detail::BagSource::Got::kSkipped) continue;
       s.sequence_record(Next::kLaser);
       s.laser.line = s.line_no;
       return Next::kLaser;
@@ -566,7 +575,8 @@ LogReader::Next LogReader::next() {
       case LogFormat::kTinySlam: got = s.parse_tinyslam(); break;
       case LogFormat::kDpSlam: got = s.parse_dpslam(); break;
       case LogFormat::kAuto:
-      case LogFormat::kRosBag: break;
+      case LogFormat::kRosBag:
+      case LogFormat::kRos2Bag: break;
     }
     if (!s.reason.empty()) {
       const bool warning = s.reason.rfind(detail::kUnknownTypePrefix, 0) == 0;

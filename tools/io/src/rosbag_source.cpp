@@ -7,18 +7,12 @@
 #include <sensor_msgs/LaserScan.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <exception>
 #include <fstream>
-#include <limits>
-#include <map>
 #include <utility>
 #include <vector>
 
-#include "sdpslam/core/capacities.h"
-#include "sdpslam/core/det_math.h"
+#include "bag_common.h"
 
 namespace sdpslam::io::detail {
 namespace {
@@ -27,60 +21,13 @@ constexpr const char* kLaserScanType = "sensor_msgs/LaserScan";
 constexpr const char* kOdometryType = "nav_msgs/Odometry";
 constexpr const char* kTfType = "tf2_msgs/TFMessage";
 
-std::int64_t stamp_us(const ros::Time& t) {
-  return static_cast<std::int64_t>(t.sec) * 1000000 + static_cast<std::int64_t>(t.nsec / 1000U);
+std::int64_t stamp_us(const ros::Time& t) { return stamp_us_of(t.sec, t.nsec); }
+
+BagTransform transform_of(const geometry_msgs::TransformStamped& x) {
+  const auto& q = x.transform.rotation;
+  return BagTransform{stamp_us(x.header.stamp), x.header.frame_id, x.child_frame_id,
+                      Pose2{x.transform.translation.x, x.transform.translation.y, yaw_of(q.x, q.y, q.z, q.w)}};
 }
-
-// Heading of a rotation about z (the yaw of a unit quaternion).
-double yaw_of(double x, double y, double z, double w) {
-  return std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
-}
-
-Pose2 pose_of(const geometry_msgs::Transform& t) {
-  return Pose2{t.translation.x, t.translation.y, yaw_of(t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w)};
-}
-
-// The frame without a leading '/' (tf2 names frames without it; tf and old bags with).
-std::string frame_name(const std::string& f) { return !f.empty() && f[0] == '/' ? f.substr(1) : f; }
-
-// Topics of `type` in the bag; the chosen one is `wanted`, else the only one, else
-// `preferred` among several. Empty with *error set when none can be chosen.
-std::string choose_topic(const std::vector<std::pair<std::string, std::string>>& topics, const char* type,
-                         const std::string& wanted, const std::string& preferred, const char* what,
-                         const char* option, bool required, std::string* error) {
-  std::vector<std::string> of_type;
-  for (const auto& t : topics) {
-    if (t.second == type && std::find(of_type.begin(), of_type.end(), t.first) == of_type.end()) {
-      of_type.push_back(t.first);
-    }
-  }
-  if (!wanted.empty()) {
-    for (const auto& t : topics) {
-      if (t.first != wanted) continue;
-      if (t.second == type) return wanted;
-      *error = "topic " + wanted + " is " + t.second + ", not " + type;
-      return std::string();
-    }
-    *error = "the bag has no topic " + wanted;
-    return std::string();
-  }
-  if (of_type.size() == 1U) return of_type[0];
-  if (std::find(of_type.begin(), of_type.end(), preferred) != of_type.end()) return preferred;
-  if (of_type.empty()) {
-    if (required) *error = std::string("the bag has no ") + type + " topic (" + what + ")";
-    return std::string();
-  }
-  std::string names;
-  for (const std::string& n : of_type) names += (names.empty() ? "" : ", ") + n;
-  *error = std::string("the bag has several ") + type + " topics (" + names + "): choose the " + what + " with " +
-           option;
-  return std::string();
-}
-
-struct OdomSample {
-  std::int64_t stamp_us;
-  Pose2 pose;
-};
 
 }  // namespace
 
@@ -90,51 +37,14 @@ struct RosBagSource::Impl {
   rosbag::View::iterator it;
   std::string scan_topic;
   std::string odom_source;  // the topic, or "/tf (odom -> base_link)"
-  std::string base_frame;
-  std::vector<OdomSample> odometry;  // by stamp
-  // Static transforms: child frame -> (parent frame, pose of the child in the parent).
-  std::map<std::string, std::pair<std::string, Pose2>> statics;
-  std::map<std::string, std::pair<bool, Pose2>> mounts;  // laser frame -> (found, pose in base)
+  BagAssembler assembler;
+  BagScan scan;
   std::uint64_t file_bytes = 0U;
   std::uint64_t scan_count = 0U;
   std::uint64_t scans_read = 0U;
-
-  // Pose of `frame` in the base frame through the static transforms.
-  std::pair<bool, Pose2> mount(const std::string& frame) {
-    auto known = mounts.find(frame);
-    if (known != mounts.end()) return known->second;
-    Pose2 in_base;  // frame in the current ancestor
-    std::string at = frame;
-    bool found = at == base_frame;
-    for (std::size_t hops = 0; !found && hops < statics.size(); ++hops) {
-      auto up = statics.find(at);
-      if (up == statics.end()) break;
-      in_base = up->second.second.compose(in_base);
-      at = up->second.first;
-      found = at == base_frame;
-    }
-    const auto result = std::make_pair(found, found ? in_base : Pose2{});
-    mounts[frame] = result;
-    return result;
-  }
-
-  bool odometry_at(std::int64_t t_us, Pose2* out) const {
-    if (odometry.empty() || t_us < odometry.front().stamp_us || t_us > odometry.back().stamp_us) return false;
-    auto hi = std::lower_bound(odometry.begin(), odometry.end(), t_us,
-                               [](const OdomSample& s, std::int64_t t) { return s.stamp_us < t; });
-    if (hi->stamp_us == t_us) {
-      *out = hi->pose;
-      return true;
-    }
-    const OdomSample& b = *hi;
-    const OdomSample& a = *(hi - 1);
-    const double f = static_cast<double>(t_us - a.stamp_us) / static_cast<double>(b.stamp_us - a.stamp_us);
-    const double turn = det::wrap_angle(b.pose.heading_rad - a.pose.heading_rad);
-    *out = Pose2{a.pose.x_m + f * (b.pose.x_m - a.pose.x_m), a.pose.y_m + f * (b.pose.y_m - a.pose.y_m),
-                 det::wrap_angle(a.pose.heading_rad + f * turn)};
-    return true;
-  }
 };
+
+bool ros1_bags_supported_here() { return true; }
 
 RosBagSource::RosBagSource() : impl_(std::make_unique<Impl>()) {}
 RosBagSource::~RosBagSource() = default;
@@ -165,7 +75,7 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
       *error = path + ": " + why;
       return false;
     }
-    s.base_frame = options.bag_base_frame;
+    s.assembler.set_base_frame(options.bag_base_frame);
     if (!odom_topic.empty()) {
       s.odom_source = odom_topic;
       rosbag::View v(s.bag, rosbag::TopicQuery(odom_topic));
@@ -174,13 +84,12 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
         nav_msgs::Odometry::ConstPtr o = m.instantiate<nav_msgs::Odometry>();
         if (o == nullptr) continue;
         if (!child_named && !o->child_frame_id.empty()) {
-          s.base_frame = frame_name(o->child_frame_id);
+          s.assembler.set_base_frame(o->child_frame_id);
           child_named = true;
         }
         const auto& q = o->pose.pose.orientation;
-        s.odometry.push_back(OdomSample{stamp_us(o->header.stamp),
-                                        Pose2{o->pose.pose.position.x, o->pose.pose.position.y,
-                                              yaw_of(q.x, q.y, q.z, q.w)}});
+        s.assembler.add_odometry(stamp_us(o->header.stamp), Pose2{o->pose.pose.position.x, o->pose.pose.position.y,
+                                                                 yaw_of(q.x, q.y, q.z, q.w)});
       }
     } else {
       const std::string tf_topic = choose_topic(topics, kTfType, std::string(), "/tf", "odometry", "--odom-topic",
@@ -190,29 +99,20 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
                  " odometry on /tf: no odometry";
         return false;
       }
-      s.odom_source = tf_topic + " (" + options.bag_odom_frame + " -> " + s.base_frame + ")";
+      s.odom_source = tf_topic + " (" + options.bag_odom_frame + " -> " + s.assembler.base_frame() + ")";
       rosbag::View v(s.bag, rosbag::TopicQuery(tf_topic));
       for (const rosbag::MessageInstance& m : v) {
         tf2_msgs::TFMessage::ConstPtr t = m.instantiate<tf2_msgs::TFMessage>();
         if (t == nullptr) continue;
         for (const auto& x : t->transforms) {
-          if (frame_name(x.header.frame_id) != options.bag_odom_frame || frame_name(x.child_frame_id) != s.base_frame) {
-            continue;
+          const BagTransform b = transform_of(x);
+          if (frame_name(b.parent) == options.bag_odom_frame && frame_name(b.child) == s.assembler.base_frame()) {
+            s.assembler.add_odometry(b.stamp_us, b.pose);
           }
-          s.odometry.push_back(OdomSample{stamp_us(x.header.stamp), pose_of(x.transform)});
         }
       }
     }
-    std::stable_sort(s.odometry.begin(), s.odometry.end(),
-                     [](const OdomSample& a, const OdomSample& b) { return a.stamp_us < b.stamp_us; });
-    // Equal stamps: the last message wins (one pose per instant keeps interpolation sane).
-    std::vector<OdomSample> unique;
-    for (const OdomSample& o : s.odometry) {
-      if (!unique.empty() && unique.back().stamp_us == o.stamp_us) unique.back() = o;
-      else unique.push_back(o);
-    }
-    s.odometry.swap(unique);
-    if (s.odometry.empty()) {
+    if (!s.assembler.finish_odometry()) {
       *error = path + ": no odometry messages in " + s.odom_source;
       return false;
     }
@@ -222,9 +122,7 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
       for (const rosbag::MessageInstance& m : v) {
         tf2_msgs::TFMessage::ConstPtr tf = m.instantiate<tf2_msgs::TFMessage>();
         if (tf == nullptr) continue;
-        for (const auto& x : tf->transforms) {
-          s.statics[frame_name(x.child_frame_id)] = std::make_pair(frame_name(x.header.frame_id), pose_of(x.transform));
-        }
+        for (const auto& x : tf->transforms) s.assembler.add_static(transform_of(x));
       }
       break;
     }
@@ -247,49 +145,24 @@ RosBagSource::Got RosBagSource::next(LaserRecord* laser, std::string* reason, bo
     const rosbag::MessageInstance& m = *s.it;
     ++s.scans_read;
     *index = static_cast<std::int64_t>(s.scans_read);
-    sensor_msgs::LaserScan::ConstPtr scan = m.instantiate<sensor_msgs::LaserScan>();
+    sensor_msgs::LaserScan::ConstPtr msg = m.instantiate<sensor_msgs::LaserScan>();
     const std::int64_t receive_us = stamp_us(m.getTime());
     ++s.it;
-    if (scan == nullptr) {
+    if (msg == nullptr) {
       *reason = "scan message " + std::to_string(*index) + " on " + s.scan_topic + " is not a " + kLaserScanType;
       return Got::kSkipped;
     }
-    if (scan->ranges.size() < 2U || scan->ranges.size() > capacity::kMaxBeams) {
-      *reason = "scan message " + std::to_string(*index) + " has " + std::to_string(scan->ranges.size()) +
-                " ranges (this build takes 2 .. " + std::to_string(capacity::kMaxBeams) + ")";
+    s.scan.stamp_us = stamp_us(msg->header.stamp);
+    s.scan.frame = msg->header.frame_id;
+    s.scan.angle_min = msg->angle_min;
+    s.scan.angle_increment = msg->angle_increment;
+    s.scan.range_min = msg->range_min;
+    s.scan.range_max = msg->range_max;
+    s.scan.ranges = msg->ranges;
+    if (!s.assembler.to_record(s.scan, receive_us, laser, reason, warning)) {
+      *reason = "scan message " + std::to_string(*index) + ": " + *reason;
       return Got::kSkipped;
     }
-    if (!std::isfinite(scan->angle_min) || !std::isfinite(scan->angle_increment) || !(scan->range_max > 0.0F) ||
-        !std::isfinite(scan->range_max) || !std::isfinite(scan->range_min)) {
-      *reason = "scan message " + std::to_string(*index) + " has a non-finite or empty geometry";
-      return Got::kSkipped;
-    }
-    *laser = LaserRecord{};
-    laser->keyword = "LaserScan";
-    laser->stamp_us = stamp_us(scan->header.stamp);
-    laser->logger_stamp_us = receive_us;
-    laser->has_stamp = true;
-    RangeScan& r = laser->scan;
-    r.stamp_us = laser->stamp_us;
-    r.geometry.angle_min_rad = scan->angle_min;
-    r.geometry.angle_increment_rad = scan->angle_increment;
-    r.geometry.range_min_m = scan->range_min;
-    r.geometry.range_max_m = scan->range_max;
-    r.beam_count = static_cast<std::uint32_t>(scan->ranges.size());
-    for (std::uint32_t i = 0; i < r.beam_count; ++i) {
-      const float v = scan->ranges[i];
-      r.ranges_m[i] = std::isnan(v) || v < 0.0F ? 0.0F : (std::isinf(v) ? scan->range_max : v);
-    }
-    const std::string frame = frame_name(scan->header.frame_id);
-    const bool first_time = s.mounts.find(frame) == s.mounts.end();
-    const auto mount = s.mount(frame);
-    r.geometry.laser_in_base = mount.second;
-    if (!mount.first && first_time) {
-      *warning = true;
-      *reason = "no /tf_static chain from " + s.base_frame + " to the scan's frame '" + frame +
-                "': the laser is taken to sit at the base's origin";
-    }
-    laser->has_odom_pose = s.odometry_at(laser->stamp_us, &laser->odom_pose);
     return Got::kLaser;
   } catch (const std::exception& e) {
     *reason = std::string("cannot read the next scan message: ") + e.what();
@@ -306,7 +179,8 @@ std::uint64_t RosBagSource::offset() const {
 }
 
 std::string RosBagSource::description() const {
-  return "scan " + impl_->scan_topic + ", odometry " + impl_->odom_source + ", base frame " + impl_->base_frame;
+  return "scan " + impl_->scan_topic + ", odometry " + impl_->odom_source + ", base frame " +
+         impl_->assembler.base_frame();
 }
 
 }  // namespace sdpslam::io::detail

@@ -27,32 +27,23 @@
 #include <memory>
 #include <string>
 
-#include "sdpslam/io/log_reader.h"
+#include "bag_common.h"
 
 namespace sdpslam::io::detail {
 
-// True iff the file starts with the ROS 1 bag magic "#ROSBAG V2.0".
-bool looks_like_rosbag(const std::string& path);
+bool ros1_bags_supported_here();  // this build's rosbag_source(_none).cpp
 
-class RosBagSource {
+class RosBagSource final : public BagSource {
  public:
-  enum class Got { kLaser, kSkipped, kEnd };
-
   RosBagSource();
-  ~RosBagSource();
+  ~RosBagSource() override;
   RosBagSource(const RosBagSource&) = delete;
   RosBagSource& operator=(const RosBagSource&) = delete;
 
-  // False (with the reason) if the bag cannot be read or has no usable scan topic.
-  bool open(const std::string& path, const LogReaderOptions& options, std::string* error);
-  // The next scan message: kLaser fills `laser` (a warning for it, if any, in *reason);
-  // kSkipped sets *reason (and *warning: skipped on purpose rather than malformed).
-  // *index is the message's 1-based position among the scan topic's messages.
-  Got next(LaserRecord* laser, std::string* reason, bool* warning, std::int64_t* index);
-  // Progress: the share of the scan messages read, scaled to the file's size in bytes.
-  std::uint64_t offset() const;
-  // What open() chose, for the run's report: "scan /scan, odometry /odom".
-  std::string description() const;
+  bool open(const std::string& path, const LogReaderOptions& options, std::string* error) override;
+  Got next(LaserRecord* laser, std::string* reason, bool* warning, std::int64_t* index) override;
+  std::uint64_t offset() const override;
+  std::string description() const override;
 
  private:
   struct Impl;

@@ -4,6 +4,8 @@
 
 namespace sdpslam::io::detail {
 
+bool ros1_bags_supported_here() { return false; }
+
 struct RosBagSource::Impl {};
 
 RosBagSource::RosBagSource() = default;

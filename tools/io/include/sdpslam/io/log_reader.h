@@ -23,7 +23,8 @@ enum class LogFormat {
   kCarmen,
   kTinySlam,
   kDpSlam,
-  kRosBag,    // a ROS 1 bag (format 2.0): LaserScan + Odometry or /tf (rosbag_source.h)
+  kRosBag,    // a ROS 1 bag (format 2.0): LaserScan + Odometry or /tf (src/rosbag_source.h)
+  kRos2Bag,   // a ROS 2 bag (rosbag2 folder or .db3: SQLite + CDR), the same messages (ros2_bag.h)
 };
 
 const char* to_string(LogFormat f);
@@ -111,7 +112,7 @@ struct LogReaderOptions {
   // Checked where the log has real timestamps; 0 = not checked.
   double max_speed_mps = 5.0;
   double max_turn_rate_radps = 10.0;
-  // ROS 1 bags: the sensor_msgs/LaserScan topic and the nav_msgs/Odometry topic (empty:
+  // ROS 1 and ROS 2 bags: the sensor_msgs/LaserScan topic and the nav_msgs/Odometry topic (empty:
   // the bag's only one, or /scan and /odom among several); without an Odometry topic the
   // odom_frame -> base_frame transforms of /tf are the odometry. The laser's mounting is
   // the /tf_static chain from the base frame (the Odometry's child_frame_id, else

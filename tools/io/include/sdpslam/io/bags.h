@@ -1,0 +1,59 @@
+#pragma once
+// ROS bags as logs, in the programs that link sdpslam_io_bags (the `sdpslam` command; not
+// the robot program, which reads no bags and links none of their libraries): after
+// enable_bag_formats(), LogReader reads ROS 1 bags (src/rosbag_source.h) and ROS 2 bags
+// (src/ros2_bag_source.h); before it, or in a program without it, a bag is refused.
+// Each kind needs its Debian packages at build time (tools/io/CMakeLists.txt); a build
+// without them refuses that kind with what to install.
+//
+// ROS 2 bags (rosbag2, SQLite 3 storage): a folder holding metadata.yaml and
+// NAME_0.db3, messages serialised as CDR (little-endian XCDR1, as rmw_fastrtps writes
+// them). LogReader reads them (LogFormat::kRos2Bag, the folder or a .db3 file: the
+// topics, odometry and mounting as for ROS 1 bags, see LogReaderOptions::bag_*); this
+// writer makes one from any log, for `sdpslam convert --to ros2`.
+//
+// Written: /scan sensor_msgs/msg/LaserScan (frame "laser"; a laser whose mounting changes
+// gets a frame of its own, "laser_2", ...), /odom nav_msgs/msg/Odometry (odom ->
+// base_link) at every scan's stamp with the odometry the scan was paired with (its own
+// pose, else the latest odometry record), /tf tf2_msgs/msg/TFMessage with the same
+// transform, /tf_static with base_link -> laser. Headings go through quaternions (about
+// 1e-16 rad). The folder appears whole at close() (written under a temporary name, then
+// renamed); an existing OUT is refused.
+//
+// Through Debian's libsqlite3-dev and libfastcdr-dev; a build without them refuses with
+// what to install (ros2_bags_supported()).
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "sdpslam/io/log_reader.h"
+
+namespace sdpslam::io {
+
+void enable_bag_formats();
+bool ros1_bags_supported();  // built with the ROS 1 packages
+bool ros2_bags_supported();  // built with libsqlite3 and Fast-CDR
+
+class Ros2BagWriter {
+ public:
+  Ros2BagWriter();
+  ~Ros2BagWriter();  // abandons (removes) an unclosed bag
+  Ros2BagWriter(const Ros2BagWriter&) = delete;
+  Ros2BagWriter& operator=(const Ros2BagWriter&) = delete;
+
+  bool open(const std::string& folder, std::string* error);
+  // The latest odometry (used for scans that carry none).
+  void odom(const OdomRecord& r);
+  // False (with the reason) iff the message could not be written.
+  bool laser(const LaserRecord& r, std::string* error);
+  std::uint64_t scans_written() const;
+  std::uint64_t scans_without_odometry() const;  // before any odometry: not written
+  // Writes metadata.yaml and moves the folder into place; false iff any step failed.
+  bool close(std::string* error);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sdpslam::io
