@@ -54,6 +54,7 @@ bool Daemon::start(std::string* error) {
   // device is opened.
   if (!outputs_.begin(config_.output_directory, error)) return false;
   if (config_.input_log && !recorder_.open(config_.output_directory + "/input.clf", error)) return false;
+  if (!config_.pose_socket.empty() && !publisher_.open(config_.pose_socket, error)) return false;
   start_us_ = io_.clock->now_us();
   next_output_us_ = start_us_ + config_.output_period_us;
   next_snapshot_us_ = start_us_ + config_.snapshot_interval_us;
@@ -151,6 +152,21 @@ void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
     const EngineStep s = io_.engine->process(slam_odom, slam_scan_);
     ++counters_.scans_placed;
     if (s.processed) ++counters_.scans_processed;
+    if (publisher_.is_open()) {
+      PoseRecord rec;
+      rec.flags = static_cast<std::uint16_t>((s.processed ? PoseRecord::kFlagProcessed : 0U) |
+                                             (std::strcmp(io_.engine->name(), "localize") == 0 ? PoseRecord::kFlagLocalize : 0U));
+      rec.map_version = map_version_;
+      rec.stamp_us = p.scan.stamp_us;
+      rec.pose = s.pose;
+      const PoseSpread spread = io_.engine->spread();
+      rec.var_x = static_cast<float>(spread.var_x);
+      rec.cov_xy = static_cast<float>(spread.cov_xy);
+      rec.var_y = static_cast<float>(spread.var_y);
+      rec.var_heading = static_cast<float>(spread.var_heading);
+      publisher_.poll();
+      publisher_.publish(rec);
+    }
     const std::int64_t done_us = io_.clock->now_us();
     const std::int64_t from_stamp = done_us - p.scan.stamp_us;
     const std::int64_t from_read = done_us - p.read_us;
@@ -223,6 +239,7 @@ void Daemon::step() {
     now = io_.clock->now_us();
   }
   update_odometry();
+  publisher_.poll();  // (un)subscriptions, also while no scan comes
   place_scans(now, false);
   watch_faults();
   now = io_.clock->now_us();
@@ -421,6 +438,7 @@ bool Daemon::write_outputs() {
   if (dt > counters_.max_output_write_us) counters_.max_output_write_us = dt;
   if (changed && ok) {
     ++counters_.output_writes;
+    if (config_.write_map) ++map_version_;
     written_at_scans_ = counters_.scans_placed;
   } else if (changed) {
     ++counters_.output_failures;
@@ -534,6 +552,16 @@ std::string Daemon::status_json() const {
                      {"write_failures", rs.write_failures},
                      {"roundtrip_changed", rs.changed_count},
                      {"roundtrip_failures", rs.roundtrip_failures}};
+  const PosePublisherStats& ps = publisher_.stats();
+  js["pose_socket"] = {{"enabled", publisher_.is_open()},
+                       {"subscribers", publisher_.subscribers()},
+                       {"records", ps.records},
+                       {"datagrams_sent", ps.datagrams_sent},
+                       {"datagrams_dropped", ps.datagrams_dropped},
+                       {"subscribes", ps.subscribes},
+                       {"subscribers_refused", ps.subscribers_refused},
+                       {"subscribers_lost", ps.subscribers_lost},
+                       {"map_version", map_version_}};
   js["engine"] = io_.engine->status_json();
   js["outputs"] = {{"writes", c.output_writes},
                    {"failures", c.output_failures},

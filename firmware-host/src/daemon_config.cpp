@@ -9,6 +9,7 @@
 #include "sdpslam/slam/run_sdp.h"
 
 #include <ini.h>
+#include <sys/un.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -387,6 +388,14 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
     }
     if (key == "write_map") return ok(boolean(v, &c.write_map, why));
     if (key == "input_log") return ok(boolean(v, &c.input_log, why));
+    if (key == "pose_socket") {
+      if (std::strlen(v) >= sizeof(sockaddr_un{}.sun_path)) {
+        *why = "a socket path has at most " + std::to_string(sizeof(sockaddr_un{}.sun_path) - 1U) + " bytes";
+        return R::kBad;
+      }
+      c.pose_socket = v;
+      return R::kOk;
+    }
     if (key == "snapshot_interval_s") {
       if (!real_in(v, 0.0, 86400.0, false, &d, why)) return R::kBad;
       c.snapshot_interval_us = static_cast<std::int64_t>(std::llround(d * 1e6));

@@ -1,5 +1,7 @@
 #include "sdpslam/daemon/slam_engine.h"
 
+#include <cmath>
+
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
@@ -9,6 +11,44 @@
 
 namespace sdpslam::daemon {
 namespace {
+
+// PoseSpread of n particle poses pose_at(i), turned by `turn_rad` into the map frame.
+template <class PoseAt>
+PoseSpread spread_of(std::uint32_t n, PoseAt&& pose_at, double turn_rad) {
+  PoseSpread s;
+  if (n < 2U) return s;
+  double mx = 0.0, my = 0.0, sc = 0.0, ss = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Pose2 p = pose_at(i);
+    mx += p.x_m;
+    my += p.y_m;
+    sc += std::cos(p.heading_rad);
+    ss += std::sin(p.heading_rad);
+  }
+  const double inv = 1.0 / static_cast<double>(n);
+  mx *= inv;
+  my *= inv;
+  const double mh = std::atan2(ss, sc);
+  double xx = 0.0, xy = 0.0, yy = 0.0, hh = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Pose2 p = pose_at(i);
+    const double dx = p.x_m - mx;
+    const double dy = p.y_m - my;
+    const double dh = std::remainder(p.heading_rad - mh, 2.0 * M_PI);
+    xx += dx * dx;
+    xy += dx * dy;
+    yy += dy * dy;
+    hh += dh * dh;
+  }
+  const double c = std::cos(turn_rad);
+  const double sn = std::sin(turn_rad);
+  // R C Rᵀ for the position block, R the rotation by turn_rad.
+  s.var_x = (c * c * xx - 2.0 * c * sn * xy + sn * sn * yy) * inv;
+  s.cov_xy = (c * sn * (xx - yy) + (c * c - sn * sn) * xy) * inv;
+  s.var_y = (sn * sn * xx + 2.0 * c * sn * xy + c * c * yy) * inv;
+  s.var_heading = hh * inv;
+  return s;
+}
 
 // Committed poses of the filter, kept for the trajectory (capacity reserved up front).
 class PathSink final : public PoseSink {
@@ -54,6 +94,10 @@ class DpSlamEngine final : public SlamEngine {
     if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
     else ++unrecorded_;
     return s;
+  }
+
+  PoseSpread spread() const override {
+    return spread_of(filter_->particle_count(), [this](std::uint32_t i) { return filter_->particle_pose(i); }, 0.0);
   }
 
   std::vector<io::StampedPose> trajectory() const override {
@@ -144,9 +188,18 @@ class SdpEngine final : public SlamEngine {
     EngineStep s;
     s.processed = r.bottom.status == StepResult::Status::kProcessed;
     s.pose = r.pose;  // global frame, best top-level particle
+    last_pose_ = r.pose;
     if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
     else ++unrecorded_;
     return s;
+  }
+
+  // The bottom-level particles live in the segment's frame: turned into the map frame by
+  // the best particle's heading there and the estimate's heading here.
+  PoseSpread spread() const override {
+    const DpSlamFilter& bottom = slam_->bottom();
+    return spread_of(bottom.particle_count(), [&bottom](std::uint32_t i) { return bottom.particle_pose(i); },
+                     last_pose_.heading_rad - bottom.best_pose().heading_rad);
   }
 
   std::vector<io::StampedPose> trajectory() const override {
@@ -234,6 +287,7 @@ class SdpEngine final : public SlamEngine {
   std::vector<slam::ScanRecord> scans_;
   std::uint64_t unrecorded_ = 0U;
   Pose2 last_odom_{};     // the last scan's odometry, in the session's odometry frame
+  Pose2 last_pose_{};     // the last scan's estimate (spread())
   Pose2 odom_offset_{};   // session frame ⊕ this = the encoders' frame since a resume
   bool rebase_pending_ = false;
   bool rebased_ = false;
@@ -284,6 +338,11 @@ class LocalizeEngine final : public SlamEngine {
   }
 
   // The estimate at each scan as it was given (localization does not revise the past).
+  PoseSpread spread() const override {
+    const Pose2* particles = mcl_->particles();
+    return spread_of(mcl_->particle_count(), [particles](std::uint32_t i) { return particles[i]; }, 0.0);
+  }
+
   std::vector<io::StampedPose> trajectory() const override { return poses_; }
 
   std::uint32_t map_image(io::OccupancyImage* image) const override {

@@ -9,7 +9,9 @@
 # served by a SCIP 2.0 emulator on a pty, the ticks as CANopen SYNC + TPDO1 frames
 # (nodes 1, 2) through sdpslamd's --can-candump replay started on the laser's instant.
 # sdpslamd records its input ([output] input_log = true: every scan fed to SLAM with its
-# odometry pose and stamp, as SLAM got them).
+# odometry pose and stamp, as SLAM got them), and publishes each scan's pose on
+# [output] pose_socket, read by tools/examples/pose_client.py: one record per recorded
+# scan, in order, with its stamp.
 #
 # Checks (zero tolerance, except that a loaded machine may make sdpslamd drop up to 5% of
 # its scans, counted: see check_recording.sh): its recording holds one line per placed
@@ -77,9 +79,15 @@ $sdp_section
 directory = $work/daemon
 period_s = 2
 input_log = true
+pose_socket = $work/pose.sock
 INI
 # The offline runner reads the same SLAM keys from its own file.
 sed -n '/^\[filter\]/,/^\[output\]/p' "$work/sdpslamd.ini" | grep -v '^\[output\]' >"$work/offline.ini"
+# The pose client subscribes (again every second until sdpslamd answers) and stops 3 s
+# after the last record.
+python3 "$(dirname "$0")/../../tools/examples/pose_client.py" "$work/pose.sock" --idle-s 3 \
+  >"$work/poses.ndjson" 2>"$work/pose_client.err" &
+client=$!
 start=$(date +%s.%N)
 "$replay" --log "$work/log.dat" --link "$work/laser" --lines "$lines" --speed "$speed" --delay-s 1.5 --tail-s 1.5 \
   --daemon "$daemon" --config "$work/sdpslamd.ini" --out "$work/daemon" --candump "$work/ticks.candump" \
@@ -94,6 +102,18 @@ grep -o '"scans": {[^}]*}' "$work/daemon/status.json"
 grep -o '"from_scan_stamp": {[^}]*}' "$work/daemon/status.json"
 grep -o '"cpu": {[^}]*}' "$work/daemon/status.json"
 grep -o '"input_log": {[^}]*}' "$work/daemon/status.json"
+wait $client || { echo "FAIL: the pose client failed"; cat "$work/pose_client.err"; exit 1; }
+grep -o '"pose_socket": {[^}]*}' "$work/daemon/status.json"
+python3 - "$work/poses.ndjson" "$work/daemon/input.clf" <<'PY' || exit 1
+import json, sys
+poses = [json.loads(l) for l in open(sys.argv[1])]
+stamps = [round(float(l.split()[-3]) * 1e6) for l in open(sys.argv[2]) if l.startswith("ROBOTLASER1")]
+print("pose socket: %d records for %d recorded scans" % (len(poses), len(stamps)))
+if not poses or [p["seq"] for p in poses] != list(range(1, len(poses) + 1)):
+    sys.exit("FAIL: the records are not 1, 2, ... in order")
+if [p["stamp_us"] for p in poses] != stamps:
+    sys.exit("FAIL: the records' stamps are not the recorded scans' stamps")
+PY
 # Exact: the offline runner on sdpslamd's recorded input.
 sh "$(dirname "$0")/check_recording.sh" "$sdpslam" "$work/daemon" "$work/daemon/status.json" "$work/offline.ini" \
   "$mode" 5 "$work/recorded" host || exit 1

@@ -139,6 +139,7 @@ TEST(SdpslamdConfig, the_shipped_file_sets_every_key_to_its_built_in_default) {
       SDPSLAM_FIELD("output.max_trajectory_scans", max_trajectory_scans),
       SDPSLAM_FIELD("output.write_map", write_map),
       SDPSLAM_FIELD("output.input_log", input_log),
+      SDPSLAM_FIELD("output.pose_socket", pose_socket),
       SDPSLAM_FIELD("output.snapshot_interval_s", snapshot_interval_us),
       SDPSLAM_FIELD("daemon.log_interval_s", log_interval_us),
       SDPSLAM_FIELD("daemon.loop_slice_ms", loop_slice_us),

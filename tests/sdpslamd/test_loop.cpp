@@ -2,12 +2,15 @@
 // waiting and skipping, stale encoders, laser hang-up and reconnection, bus-off, queue
 // exhaustion, outputs written atomically, a failed write keeping the previous files.
 #include <CppUTest/TestHarness.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -520,6 +523,40 @@ TEST(SdpslamdLoop, a_switch_to_localization_keeps_the_session_map_and_localizes_
 
 // Every pass of the loop reports to the watchdog, with or without sensors: a supervisor
 // hears from a running loop whatever the robot's hardware does, and only from it.
+TEST(SdpslamdLoop, each_placed_scan_s_pose_goes_to_the_pose_socket_s_subscribers) {
+  Rig r;
+  r.config.pose_socket = r.config.output_directory + "/pose.sock";
+  r.make();
+  // A client: its own bound datagram socket, subscribed with one datagram.
+  const std::string me = r.config.output_directory + "/client.sock";
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+  sockaddr_un a{};
+  a.sun_family = AF_UNIX;
+  std::strcpy(a.sun_path, me.c_str());
+  CHECK(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0);
+  sockaddr_un server{};
+  server.sun_family = AF_UNIX;
+  std::strcpy(server.sun_path, r.config.pose_socket.c_str());
+  CHECK(::sendto(fd, "SUBSCRIBE", 9, 0, reinterpret_cast<sockaddr*>(&server), sizeof server) == 9);
+  r.scan_between_odometry(0, 1000000);
+  r.scan_between_odometry(1000, 2000000);
+  LONGS_EQUAL(2, r.engine.got.size());
+  for (std::size_t k = 0; k < 2; ++k) {
+    unsigned char buf[128];
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    PoseRecord rec;
+    CHECK_TRUE(sdpslam::daemon::decode_pose_record(buf, static_cast<std::size_t>(n > 0 ? n : 0), &rec));
+    LONGS_EQUAL(k + 1U, rec.sequence);
+    LONGS_EQUAL(r.engine.got[k].stamp_us, rec.stamp_us);
+    DOUBLES_EQUAL(r.engine.got[k].pose.x_m, rec.pose.x_m, 0.0);  // the fake engine returns the odometry
+    LONGS_EQUAL(PoseRecord::kFlagProcessed, rec.flags);
+  }
+  LONGS_EQUAL(1, r.d->pose_publisher().subscribers());
+  LONGS_EQUAL(2, r.d->pose_publisher().stats().datagrams_sent);
+  ::close(fd);
+  ::unlink(me.c_str());
+}
+
 TEST(SdpslamdLoop, every_step_pats_the_watchdog_whether_or_not_the_sensors_answer) {
   Rig r;
   r.make();

@@ -172,3 +172,21 @@ TEST(SdpEngineSnapshot, a_foreign_or_damaged_snapshot_is_kept_aside_and_the_map_
   }
   std::fclose(log_file);
 }
+
+// The live pose's covariance (SlamEngine::spread(), [output] pose_socket): the bottom-level
+// particles' spread, a covariance matrix (non-negative variances, |cov| within them), of
+// the size scan matching leaves (centimetres) after the particles have spread and
+// converged along a box.
+TEST(SdpEngineSnapshot, the_estimate_s_spread_is_a_covariance_of_centimetres) {
+  const DaemonConfig c = sdp_config(sdpslam::test::make_temp_dir("sdp_engine_spread"));
+  std::string error;
+  auto e = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(e != nullptr, error.c_str());
+  feed(*e, 0, 40, 1000);
+  const sdpslam::daemon::PoseSpread s = e->spread();
+  CHECK(s.var_x >= 0.0 && s.var_y >= 0.0 && s.var_heading >= 0.0);
+  CHECK(s.cov_xy * s.cov_xy <= s.var_x * s.var_y * (1.0 + 1e-9));
+  CHECK(s.var_x + s.var_y > 0.0);            // the particles are not one
+  CHECK(s.var_x + s.var_y < 0.1 * 0.1);      // within decimetres of each other
+  CHECK(s.var_heading < 0.1 * 0.1);
+}

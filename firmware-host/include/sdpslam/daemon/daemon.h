@@ -14,7 +14,9 @@
 //      older than the ring, or whose bracketing samples straddle a break or a gap longer
 //      than max_interpolation_gap_us, is skipped and counted;
 //   4. feeds placed scans to the SlamEngine (as their CARMEN line reads back, and appends
-//      that line to <output>/input.clf when [output] input_log is on: InputRecorder) and records the latency: pose available minus
+//      that line to <output>/input.clf when [output] input_log is on: InputRecorder),
+//      sends the pose to the subscribers of [output] pose_socket (PosePublisher), and
+//      records the latency: pose available minus
 //      the scan's stamp (for SCIP the sensor's stamp mapped onto our clock, ≈ its last
 //      byte's arrival on an idle line) and minus the moment the driver returned it;
 //   5. watches the sensors' counters and states and logs every change (EventLog);
@@ -45,6 +47,7 @@
 #include "sdpslam/daemon/input_recorder.h"
 #include "sdpslam/daemon/odometry_ring.h"
 #include "sdpslam/daemon/paired_wheel_encoders.h"
+#include "sdpslam/daemon/pose_publisher.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/drivers/diff_drive_odometry.h"
 #include "sdpslam/hal/byte_stream.h"
@@ -163,6 +166,7 @@ class Daemon {
   LatencyFigures latency_from_read() const { return figures(read_latency_, read_latency_max_us_, latency_count_); }
   const OdometryRing& odometry_ring() const { return ring_; }
   const InputRecorder& input_recorder() const { return recorder_; }
+  const PosePublisher& pose_publisher() const { return publisher_; }
   const hal::OdometryReading odometry() const { return odom_.latest(); }
   std::string status_json() const;
   std::size_t queued_scans() const { return queue_.size(); }
@@ -196,6 +200,8 @@ class Daemon {
   RingBuffer<PendingScan, DaemonConfig::kMaxScanQueue> queue_;
   RangeScan scratch_;
   InputRecorder recorder_;
+  PosePublisher publisher_;
+  std::uint32_t map_version_ = 0U;  // map deliveries so far (PoseRecord::map_version)
   io::OutputSet outputs_;  // trajectory and map, delivered together (manifest.txt)
   std::uint64_t written_at_scans_ = ~std::uint64_t{0};  // scans_placed at the last delivered set
   RangeScan slam_scan_;  // the placed scan as SLAM gets it (InputRecorder::pass)

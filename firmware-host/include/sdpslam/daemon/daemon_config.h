@@ -86,6 +86,9 @@ struct DaemonConfig {
   std::uint32_t max_trajectory_scans = 200000U;
   bool write_map = true;
   bool input_log = false;                    // stream every scan fed to SLAM to <directory>/input.clf
+  // Each placed scan's pose to the subscribers of this UNIX datagram socket (empty: off;
+  // pose_publisher.h).
+  std::string pose_socket;
   // Mode sdp: the whole SLAM state goes to <directory>/snapshot.sdps this often (and at
   // a stop), and a start resumes from it (0 = never; snapshot_file.h, Daemon).
   std::int64_t snapshot_interval_us = 300000000;

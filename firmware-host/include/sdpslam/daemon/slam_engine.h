@@ -26,6 +26,18 @@
 
 namespace sdpslam::daemon {
 
+// The spread of the particles behind an estimate, map frame: the sample covariance of
+// their positions (m²) and the variance of their headings about their circular mean
+// (rad²). It measures the filter's own dispersion (dpslam and sdp: the bottom-level
+// particles, whose segment frame is turned into the map frame; localize: the
+// localizer's), not the top level's choice among submaps.
+struct PoseSpread {
+  double var_x = 0.0;
+  double cov_xy = 0.0;
+  double var_y = 0.0;
+  double var_heading = 0.0;
+};
+
 struct EngineStep {
   bool processed = false;  // false: skipped by the filter (too little motion)
   Pose2 pose;              // best estimate at the scan, map frame
@@ -40,6 +52,8 @@ class SlamEngine {
   virtual std::vector<io::StampedPose> trajectory() const = 0;
   // The current best map; returns its known cells (image width 0 when empty).
   virtual std::uint32_t map_image(io::OccupancyImage* image) const = 0;
+  // The spread behind the last process()'s estimate (computed on demand: O(particles)).
+  virtual PoseSpread spread() const { return PoseSpread{}; }
   // Engine counters: the members of status.json's "engine" object.
   virtual io::Json status_json() const = 0;
   virtual std::uint64_t unrecorded_scans() const = 0;
