@@ -52,6 +52,38 @@ std::string choose_topic(const std::vector<std::pair<std::string, std::string>>&
   return std::string();
 }
 
+bool BagSource::choose_topics(const std::vector<std::pair<std::string, std::string>>& topics, const char* scan_type,
+                              const char* odom_type, const LogReaderOptions& options, const std::string& path,
+                              std::string* odom_topic, std::string* error) {
+  std::string why;
+  scan_topic_ =
+      choose_topic(topics, scan_type, options.bag_scan_topic, "/scan", "scan topic", "--scan-topic", true, &why);
+  if (scan_topic_.empty()) {
+    *error = path + ": " + why;
+    return false;
+  }
+  *odom_topic = choose_topic(topics, odom_type, options.bag_odom_topic, "/odom", "odometry topic", "--odom-topic",
+                             false, &why);
+  if (odom_topic->empty() && !why.empty()) {
+    *error = path + ": " + why;
+    return false;
+  }
+  assembler_.set_base_frame(options.bag_base_frame);
+  return true;
+}
+
+std::uint64_t BagSource::offset() const {
+  if (scan_count_ == 0U) return 0U;
+  return static_cast<std::uint64_t>(static_cast<double>(bag_bytes_) * static_cast<double>(scans_read_) /
+                                    static_cast<double>(scan_count_));
+}
+
+std::string BagSource::description() const {
+  return scan_topic_.empty() ? std::string()
+                             : "scan " + scan_topic_ + ", odometry " + odom_source_ + ", base frame " +
+                                   assembler_.base_frame();
+}
+
 bool BagAssembler::finish_odometry() {
   std::stable_sort(odometry_.begin(), odometry_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -45,23 +45,6 @@ std::string choose_topic(const std::vector<std::pair<std::string, std::string>>&
                          const std::string& wanted, const std::string& preferred, const char* what,
                          const char* option, bool required, std::string* error);
 
-// A bag read as a log (RosBagSource, Ros2BagSource): scan messages in time order.
-class BagSource {
- public:
-  enum class Got { kLaser, kSkipped, kEnd };
-  virtual ~BagSource() = default;
-  // False (with the reason) if the bag cannot be read or has no usable scan topic.
-  virtual bool open(const std::string& path, const LogReaderOptions& options, std::string* error) = 0;
-  // The next scan message: kLaser fills `laser` (a warning for it, if any, in *reason);
-  // kSkipped sets *reason (and *warning: skipped on purpose rather than malformed).
-  // *index is the message's 1-based position among the scan topic's messages.
-  virtual Got next(LaserRecord* laser, std::string* reason, bool* warning, std::int64_t* index) = 0;
-  // Progress: the share of the scan messages read, scaled to the bag's size in bytes.
-  virtual std::uint64_t offset() const = 0;
-  // What open() chose: "scan /scan, odometry /odom, base frame base_link".
-  virtual std::string description() const = 0;
-};
-
 // True iff the file starts with the ROS 1 bag magic "#ROSBAG V2.0".
 bool looks_like_rosbag(const std::string& path);
 // A folder with a metadata.yaml or .db3 files, or a file that starts as SQLite 3 does.
@@ -69,6 +52,7 @@ bool looks_like_ros2_bag(const std::string& path);
 
 // What LogReader opens a bag with: set by enable_bag_formats() (sdpslam_io_bags); null
 // in a program that reads no bags.
+class BagSource;
 using BagSourceMaker = std::unique_ptr<BagSource> (*)();
 extern BagSourceMaker g_make_ros1_source;
 extern BagSourceMaker g_make_ros2_source;
@@ -95,6 +79,40 @@ class BagAssembler {
   std::vector<std::pair<std::int64_t, Pose2>> odometry_;
   std::map<std::string, std::pair<std::string, Pose2>> statics_;  // child -> (parent, pose)
   std::map<std::string, std::pair<bool, Pose2>> mounts_;          // frame -> (found, in base)
+};
+
+// A bag read as a log (RosBagSource, Ros2BagSource): scan messages in time order.
+class BagSource {
+ public:
+  enum class Got { kLaser, kSkipped, kEnd };
+  virtual ~BagSource() = default;
+  // False (with the reason) if the bag cannot be read or has no usable scan topic.
+  virtual bool open(const std::string& path, const LogReaderOptions& options, std::string* error) = 0;
+  // The next scan message: kLaser fills `laser` (a warning for it, if any, in *reason);
+  // kSkipped sets *reason (and *warning: skipped on purpose rather than malformed).
+  // *index is the message's 1-based position among the scan topic's messages.
+  virtual Got next(LaserRecord* laser, std::string* reason, bool* warning, std::int64_t* index) = 0;
+  // Progress: the share of the scan messages read, scaled to the bag's size in bytes.
+  std::uint64_t offset() const;
+  // What open() chose: "scan /scan, odometry /odom, base frame base_link".
+  std::string description() const;
+
+ protected:
+  // The scan topic (into scan_topic_) and the odometry topic (empty: none, use /tf) among
+  // the bag's (name, type) pairs, by `options`, with the message types of this kind of
+  // bag; the base frame starts as options' (an Odometry's child_frame_id replaces it).
+  // False with *error ("PATH: why") when no choice can be made.
+  bool choose_topics(const std::vector<std::pair<std::string, std::string>>& topics, const char* scan_type,
+                     const char* odom_type, const LogReaderOptions& options, const std::string& path,
+                     std::string* odom_topic, std::string* error);
+
+  // Set by the sources as they open and read.
+  std::string scan_topic_;
+  std::string odom_source_;  // the odometry topic, or "/tf (odom -> base_link)"
+  std::uint64_t bag_bytes_ = 0U;
+  std::uint64_t scan_count_ = 0U;
+  std::uint64_t scans_read_ = 0U;
+  BagAssembler assembler_;
 };
 
 }  // namespace sdpslam::io::detail

@@ -421,15 +421,9 @@ struct Ros2BagSource::Impl {
     std::map<std::string, std::pair<int, std::string>> topics;  // name -> (id, type)
   };
   std::vector<std::unique_ptr<File>> files;
-  std::string scan_topic;
-  std::string odom_source;
-  BagAssembler assembler;
   BagScan scan;
   std::size_t file_index = 0U;
   Statement scans;
-  std::uint64_t total_bytes = 0U;
-  std::uint64_t scan_count = 0U;
-  std::uint64_t scans_read = 0U;
 
   // Every message of `topic`, in time order over the files: f(timestamp_ns, data, size).
   template <class F>
@@ -452,7 +446,7 @@ struct Ros2BagSource::Impl {
   }
 
   // Positions `scans` on the next file that has the scan topic; false when none is left.
-  bool start_file() {
+  bool start_file(const std::string& scan_topic) {
     for (; file_index < files.size(); ++file_index) {
       File& file = *files[file_index];
       auto t = file.topics.find(scan_topic);
@@ -531,30 +525,19 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions& option
       file->topics[name] = {sqlite3_column_int(st.st, 0), type};
       topics.emplace_back(name, type);
     }
-    s.total_bytes += static_cast<std::uint64_t>(fs::file_size(p, ec));
+    bag_bytes_ += static_cast<std::uint64_t>(fs::file_size(p, ec));
     s.files.push_back(std::move(file));
   }
+  std::string odom_topic;
+  if (!choose_topics(topics, kLaserScanType, kOdometryType, options, path, &odom_topic, error)) return false;
   std::string why;
-  s.scan_topic =
-      choose_topic(topics, kLaserScanType, options.bag_scan_topic, "/scan", "scan topic", "--scan-topic", true, &why);
-  if (s.scan_topic.empty()) {
-    *error = path + ": " + why;
-    return false;
-  }
-  const std::string odom_topic = choose_topic(topics, kOdometryType, options.bag_odom_topic, "/odom",
-                                              "odometry topic", "--odom-topic", false, &why);
-  if (odom_topic.empty() && !why.empty()) {
-    *error = path + ": " + why;
-    return false;
-  }
-  s.assembler.set_base_frame(options.bag_base_frame);
   std::size_t bad = 0U;
   std::string first_bad;
   const auto note_bad = [&](const std::string& topic, const std::exception& e) {
     if (bad++ == 0U) first_bad = topic + ": " + e.what();
   };
   if (!odom_topic.empty()) {
-    s.odom_source = odom_topic;
+    odom_source_ = odom_topic;
     bool child_named = false;
     if (!s.each(odom_topic, error, [&](std::int64_t, const void* data, std::size_t n) {
           try {
@@ -563,10 +546,10 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions& option
             Pose2 pose;
             decode_odometry(data, n, &stamp, &child, &pose);
             if (!child_named && !child.empty()) {
-              s.assembler.set_base_frame(child);
+              assembler_.set_base_frame(child);
               child_named = true;
             }
-            s.assembler.add_odometry(stamp, pose);
+            assembler_.add_odometry(stamp, pose);
           } catch (const std::exception& e) {
             note_bad(odom_topic, e);
           }
@@ -581,14 +564,14 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions& option
                " odometry on /tf: no odometry";
       return false;
     }
-    s.odom_source = tf_topic + " (" + options.bag_odom_frame + " -> " + s.assembler.base_frame() + ")";
+    odom_source_ = tf_topic + " (" + options.bag_odom_frame + " -> " + assembler_.base_frame() + ")";
     std::vector<BagTransform> ts;
     if (!s.each(tf_topic, error, [&](std::int64_t, const void* data, std::size_t n) {
           try {
             decode_tf(data, n, &ts);
             for (const BagTransform& t : ts) {
-              if (frame_name(t.parent) == options.bag_odom_frame && frame_name(t.child) == s.assembler.base_frame()) {
-                s.assembler.add_odometry(t.stamp_us, t.pose);
+              if (frame_name(t.parent) == options.bag_odom_frame && frame_name(t.child) == assembler_.base_frame()) {
+                assembler_.add_odometry(t.stamp_us, t.pose);
               }
             }
           } catch (const std::exception& e) {
@@ -598,8 +581,8 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions& option
       return false;
     }
   }
-  if (!s.assembler.finish_odometry()) {
-    *error = path + ": no odometry messages in " + s.odom_source +
+  if (!assembler_.finish_odometry()) {
+    *error = path + ": no odometry messages in " + odom_source_ +
              (bad > 0U ? " (" + std::to_string(bad) + " did not decode; the first: " + first_bad + ")" : "");
     return false;
   }
@@ -607,15 +590,15 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions& option
   if (!s.each("/tf_static", error, [&](std::int64_t, const void* data, std::size_t n) {
         try {
           decode_tf(data, n, &ts);
-          for (const BagTransform& t : ts) s.assembler.add_static(t);
+          for (const BagTransform& t : ts) assembler_.add_static(t);
         } catch (const std::exception& e) {
           note_bad("/tf_static", e);
         }
       })) {
     return false;
   }
-  if (!s.each(s.scan_topic, error, [&](std::int64_t, const void*, std::size_t) { ++s.scan_count; })) return false;
-  s.start_file();
+  if (!s.each(scan_topic_, error, [&](std::int64_t, const void*, std::size_t) { ++scan_count_; })) return false;
+  s.start_file(scan_topic_);
   return true;
 }
 
@@ -627,11 +610,11 @@ BagSource::Got Ros2BagSource::next(LaserRecord* laser, std::string* reason, bool
     if (s.scans.st == nullptr || sqlite3_step(s.scans.st) != SQLITE_ROW) {
       ++s.file_index;
       s.scans = Statement();
-      if (!s.start_file()) return Got::kEnd;
+      if (!s.start_file(scan_topic_)) return Got::kEnd;
       continue;
     }
-    ++s.scans_read;
-    *index = static_cast<std::int64_t>(s.scans_read);
+    ++scans_read_;
+    *index = static_cast<std::int64_t>(scans_read_);
     const std::int64_t receive_us = sqlite3_column_int64(s.scans.st, 0) / 1000;
     try {
       decode_scan(sqlite3_column_blob(s.scans.st, 1), static_cast<std::size_t>(sqlite3_column_bytes(s.scans.st, 1)),
@@ -640,25 +623,13 @@ BagSource::Got Ros2BagSource::next(LaserRecord* laser, std::string* reason, bool
       *reason = "scan message " + std::to_string(*index) + " does not decode as " + kLaserScanType + ": " + e.what();
       return Got::kSkipped;
     }
-    if (!s.assembler.to_record(s.scan, receive_us, laser, reason, warning)) {
+    if (!assembler_.to_record(s.scan, receive_us, laser, reason, warning)) {
       *reason = "scan message " + std::to_string(*index) + ": " + *reason;
       return Got::kSkipped;
     }
     return Got::kLaser;
   }
   return Got::kEnd;
-}
-
-std::uint64_t Ros2BagSource::offset() const {
-  const Impl& s = *impl_;
-  if (s.scan_count == 0U) return 0U;
-  return static_cast<std::uint64_t>(static_cast<double>(s.total_bytes) * static_cast<double>(s.scans_read) /
-                                    static_cast<double>(s.scan_count));
-}
-
-std::string Ros2BagSource::description() const {
-  return "scan " + impl_->scan_topic + ", odometry " + impl_->odom_source + ", base frame " +
-         impl_->assembler.base_frame();
 }
 
 }  // namespace detail

@@ -36,8 +36,6 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions&, std::
   return false;
 }
 BagSource::Got Ros2BagSource::next(LaserRecord*, std::string*, bool*, std::int64_t*) { return Got::kEnd; }
-std::uint64_t Ros2BagSource::offset() const { return 0U; }
-std::string Ros2BagSource::description() const { return std::string(); }
 }  // namespace detail
 
 }  // namespace sdpslam::io

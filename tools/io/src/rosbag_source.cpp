@@ -35,13 +35,7 @@ struct RosBagSource::Impl {
   rosbag::Bag bag;
   std::unique_ptr<rosbag::View> scans;
   rosbag::View::iterator it;
-  std::string scan_topic;
-  std::string odom_source;  // the topic, or "/tf (odom -> base_link)"
-  BagAssembler assembler;
   BagScan scan;
-  std::uint64_t file_bytes = 0U;
-  std::uint64_t scan_count = 0U;
-  std::uint64_t scans_read = 0U;
 };
 
 bool ros1_bags_supported_here() { return true; }
@@ -55,40 +49,29 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
     s.bag.open(path, rosbag::bagmode::Read);
     {
       std::ifstream f(path, std::ios::binary | std::ios::ate);
-      s.file_bytes = f ? static_cast<std::uint64_t>(f.tellg()) : 0U;
+      bag_bytes_ = f ? static_cast<std::uint64_t>(f.tellg()) : 0U;
     }
     std::vector<std::pair<std::string, std::string>> topics;  // (topic, type)
     {
       rosbag::View all(s.bag);
       for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.emplace_back(c->topic, c->datatype);
     }
+    std::string odom_topic;
+    if (!choose_topics(topics, kLaserScanType, kOdometryType, options, path, &odom_topic, error)) return false;
     std::string why;
-    s.scan_topic = choose_topic(topics, kLaserScanType, options.bag_scan_topic, "/scan", "scan topic",
-                                "--scan-topic", true, &why);
-    if (s.scan_topic.empty()) {
-      *error = path + ": " + why;
-      return false;
-    }
-    const std::string odom_topic = choose_topic(topics, kOdometryType, options.bag_odom_topic, "/odom",
-                                                "odometry topic", "--odom-topic", false, &why);
-    if (odom_topic.empty() && !why.empty()) {
-      *error = path + ": " + why;
-      return false;
-    }
-    s.assembler.set_base_frame(options.bag_base_frame);
     if (!odom_topic.empty()) {
-      s.odom_source = odom_topic;
+      odom_source_ = odom_topic;
       rosbag::View v(s.bag, rosbag::TopicQuery(odom_topic));
       bool child_named = false;
       for (const rosbag::MessageInstance& m : v) {
         nav_msgs::Odometry::ConstPtr o = m.instantiate<nav_msgs::Odometry>();
         if (o == nullptr) continue;
         if (!child_named && !o->child_frame_id.empty()) {
-          s.assembler.set_base_frame(o->child_frame_id);
+          assembler_.set_base_frame(o->child_frame_id);
           child_named = true;
         }
         const auto& q = o->pose.pose.orientation;
-        s.assembler.add_odometry(stamp_us(o->header.stamp), Pose2{o->pose.pose.position.x, o->pose.pose.position.y,
+        assembler_.add_odometry(stamp_us(o->header.stamp), Pose2{o->pose.pose.position.x, o->pose.pose.position.y,
                                                                  yaw_of(q.x, q.y, q.z, q.w)});
       }
     } else {
@@ -99,21 +82,21 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
                  " odometry on /tf: no odometry";
         return false;
       }
-      s.odom_source = tf_topic + " (" + options.bag_odom_frame + " -> " + s.assembler.base_frame() + ")";
+      odom_source_ = tf_topic + " (" + options.bag_odom_frame + " -> " + assembler_.base_frame() + ")";
       rosbag::View v(s.bag, rosbag::TopicQuery(tf_topic));
       for (const rosbag::MessageInstance& m : v) {
         tf2_msgs::TFMessage::ConstPtr t = m.instantiate<tf2_msgs::TFMessage>();
         if (t == nullptr) continue;
         for (const auto& x : t->transforms) {
           const BagTransform b = transform_of(x);
-          if (frame_name(b.parent) == options.bag_odom_frame && frame_name(b.child) == s.assembler.base_frame()) {
-            s.assembler.add_odometry(b.stamp_us, b.pose);
+          if (frame_name(b.parent) == options.bag_odom_frame && frame_name(b.child) == assembler_.base_frame()) {
+            assembler_.add_odometry(b.stamp_us, b.pose);
           }
         }
       }
     }
-    if (!s.assembler.finish_odometry()) {
-      *error = path + ": no odometry messages in " + s.odom_source;
+    if (!assembler_.finish_odometry()) {
+      *error = path + ": no odometry messages in " + odom_source_;
       return false;
     }
     for (const auto& t : topics) {
@@ -122,12 +105,12 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions& options
       for (const rosbag::MessageInstance& m : v) {
         tf2_msgs::TFMessage::ConstPtr tf = m.instantiate<tf2_msgs::TFMessage>();
         if (tf == nullptr) continue;
-        for (const auto& x : tf->transforms) s.assembler.add_static(transform_of(x));
+        for (const auto& x : tf->transforms) assembler_.add_static(transform_of(x));
       }
       break;
     }
-    s.scans = std::make_unique<rosbag::View>(s.bag, rosbag::TopicQuery(s.scan_topic));
-    s.scan_count = s.scans->size();
+    s.scans = std::make_unique<rosbag::View>(s.bag, rosbag::TopicQuery(scan_topic_));
+    scan_count_ = s.scans->size();
     s.it = s.scans->begin();
   } catch (const std::exception& e) {
     *error = path + ": cannot read the ROS bag: " + e.what();
@@ -143,13 +126,13 @@ RosBagSource::Got RosBagSource::next(LaserRecord* laser, std::string* reason, bo
   try {
     if (s.scans == nullptr || s.it == s.scans->end()) return Got::kEnd;
     const rosbag::MessageInstance& m = *s.it;
-    ++s.scans_read;
-    *index = static_cast<std::int64_t>(s.scans_read);
+    ++scans_read_;
+    *index = static_cast<std::int64_t>(scans_read_);
     sensor_msgs::LaserScan::ConstPtr msg = m.instantiate<sensor_msgs::LaserScan>();
     const std::int64_t receive_us = stamp_us(m.getTime());
     ++s.it;
     if (msg == nullptr) {
-      *reason = "scan message " + std::to_string(*index) + " on " + s.scan_topic + " is not a " + kLaserScanType;
+      *reason = "scan message " + std::to_string(*index) + " on " + scan_topic_ + " is not a " + kLaserScanType;
       return Got::kSkipped;
     }
     s.scan.stamp_us = stamp_us(msg->header.stamp);
@@ -159,7 +142,7 @@ RosBagSource::Got RosBagSource::next(LaserRecord* laser, std::string* reason, bo
     s.scan.range_min = msg->range_min;
     s.scan.range_max = msg->range_max;
     s.scan.ranges = msg->ranges;
-    if (!s.assembler.to_record(s.scan, receive_us, laser, reason, warning)) {
+    if (!assembler_.to_record(s.scan, receive_us, laser, reason, warning)) {
       *reason = "scan message " + std::to_string(*index) + ": " + *reason;
       return Got::kSkipped;
     }
@@ -169,18 +152,6 @@ RosBagSource::Got RosBagSource::next(LaserRecord* laser, std::string* reason, bo
     if (s.scans != nullptr) s.it = s.scans->end();
     return Got::kSkipped;
   }
-}
-
-std::uint64_t RosBagSource::offset() const {
-  const Impl& s = *impl_;
-  if (s.scan_count == 0U) return 0U;
-  return static_cast<std::uint64_t>(static_cast<double>(s.file_bytes) * static_cast<double>(s.scans_read) /
-                                    static_cast<double>(s.scan_count));
-}
-
-std::string RosBagSource::description() const {
-  return "scan " + impl_->scan_topic + ", odometry " + impl_->odom_source + ", base frame " +
-         impl_->assembler.base_frame();
 }
 
 }  // namespace sdpslam::io::detail

@@ -42,8 +42,6 @@ class RosBagSource final : public BagSource {
 
   bool open(const std::string& path, const LogReaderOptions& options, std::string* error) override;
   Got next(LaserRecord* laser, std::string* reason, bool* warning, std::int64_t* index) override;
-  std::uint64_t offset() const override;
-  std::string description() const override;
 
  private:
   struct Impl;

@@ -18,7 +18,5 @@ bool RosBagSource::open(const std::string& path, const LogReaderOptions&, std::s
 }
 
 RosBagSource::Got RosBagSource::next(LaserRecord*, std::string*, bool*, std::int64_t*) { return Got::kEnd; }
-std::uint64_t RosBagSource::offset() const { return 0U; }
-std::string RosBagSource::description() const { return std::string(); }
 
 }  // namespace sdpslam::io::detail
