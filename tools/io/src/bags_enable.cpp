@@ -15,6 +15,4 @@ void enable_bag_formats() {
   };
 }
 
-bool ros1_bags_supported() { return detail::ros1_bags_supported_here(); }
-
 }  // namespace sdpslam::io

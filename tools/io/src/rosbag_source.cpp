@@ -38,8 +38,6 @@ struct RosBagSource::Impl {
   BagScan scan;
 };
 
-bool ros1_bags_supported_here() { return true; }
-
 RosBagSource::RosBagSource() : impl_(std::make_unique<Impl>()) {}
 RosBagSource::~RosBagSource() = default;
 

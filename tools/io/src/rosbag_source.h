@@ -31,8 +31,6 @@
 
 namespace sdpslam::io::detail {
 
-bool ros1_bags_supported_here();  // this build's rosbag_source(_none).cpp
-
 class RosBagSource final : public BagSource {
  public:
   RosBagSource();

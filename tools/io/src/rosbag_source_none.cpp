@@ -4,8 +4,6 @@
 
 namespace sdpslam::io::detail {
 
-bool ros1_bags_supported_here() { return false; }
-
 struct RosBagSource::Impl {};
 
 RosBagSource::RosBagSource() = default;

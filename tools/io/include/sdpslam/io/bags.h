@@ -16,9 +16,10 @@
 // gets a frame of its own, "laser_2", ...), /odom nav_msgs/msg/Odometry (odom ->
 // base_link) at every scan's stamp with the odometry the scan was paired with (its own
 // pose, else the latest odometry record), /tf tf2_msgs/msg/TFMessage with the same
-// transform, /tf_static with base_link -> laser. Headings go through quaternions (about
-// 1e-16 rad). The folder appears whole at close() (written under a temporary name, then
-// renamed); an existing OUT is refused.
+// transform, /tf_static with base_link -> laser. Each heading's quaternion is chosen
+// (within a few ulps of the exact one) so that LogReader gives the heading back bit for
+// bit: a log written as a bag runs as the log. The folder appears whole at close()
+// (written under a temporary name, then renamed); an existing OUT is refused.
 //
 // Through Debian's libsqlite3-dev and libfastcdr-dev; a build without them refuses with
 // what to install (ros2_bags_supported()).
@@ -31,7 +32,6 @@
 namespace sdpslam::io {
 
 void enable_bag_formats();
-bool ros1_bags_supported();  // built with the ROS 1 packages
 bool ros2_bags_supported();  // built with libsqlite3 and Fast-CDR
 
 class Ros2BagWriter {
