@@ -84,6 +84,8 @@ set(SDPSLAM_INSTALL_SYSTEMDDIR "lib/systemd/system")
 
 if(TARGET sdpslam)
   install(TARGETS sdpslam RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+  # Its ROS bag plugin (tools/io/CMakeLists.txt), found through its $ORIGIN run path.
+  install(TARGETS sdpslam_bags LIBRARY DESTINATION ${SDPSLAM_BAG_PLUGIN_INSTALL_DIR} COMPONENT runtime)
 endif()
 set(_sdpslam_conffiles "")
 set(_sdpslam_has_daemon OFF)

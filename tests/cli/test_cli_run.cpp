@@ -104,6 +104,20 @@ TEST(CliRun, past_the_first_lines_of_a_kind_the_rest_are_counted) {
   STRCMP_CONTAINS("26 log errors", r.out.c_str());
 }
 
+// ROS bag support lives in a plugin (sdpslam/io/bags.h): a run on a CARMEN log loads
+// neither it nor the ROS, SQLite and Fast-CDR libraries, which would hold several MiB of
+// the robot computer's memory for nothing. glibc's loader names every object it loads.
+TEST(CliRun, a_run_on_a_carmen_log_loads_no_bag_library) {
+  const std::string log = log_with_bad_lines(0);
+  const Run r = sdpslam::test::run_program("LD_DEBUG=files " + std::string(SDPSLAM_CLI_PATH) + " run " + log +
+                                           " --out " + dir + "/out");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("libc.so", r.out.c_str());  // the loader did report what it loaded
+  for (const char* lib : {"sdpslam_bags", "rosbag", "sqlite3", "fastcdr", "boost"}) {
+    CHECK_TEXT(r.out.find(lib) == std::string::npos, lib);
+  }
+}
+
 // The hostile case: a 1 km odometry jump. The line is named, the jump is not
 // applied (the trajectory moves centimetres, not a kilometre), stats.json counts it; a
 // scan stamped before the one it follows is reported with its line.

@@ -24,9 +24,12 @@ using sdpslam::io::Ros2BagWriter;
 
 namespace {
 
+// The bag plugin is loaded before any test runs: the ROS libraries' statics it brings
+// would otherwise be blamed on the first test that opens a bag.
 const bool kBagsEnabled = [] {
   sdpslam::io::enable_bag_formats();
-  return true;
+  std::string error;
+  return sdpslam::io::load_bag_plugin(&error);
 }();
 
 LaserRecord scan_at(std::int64_t stamp_us, float value, const Pose2& odom, const Pose2& mount) {

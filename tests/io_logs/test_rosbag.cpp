@@ -28,9 +28,12 @@ using sdpslam::io::LogReaderOptions;
 
 namespace {
 
+// The bag plugin is loaded before any test runs: the ROS libraries' statics it brings
+// would otherwise be blamed on the first test that opens a bag.
 const bool kBagsEnabled = [] {
   sdpslam::io::enable_bag_formats();
-  return true;
+  std::string error;
+  return sdpslam::io::load_bag_plugin(&error);
 }();
 
 // rosbag_storage keeps process-wide state allocated on its first use (its encryptor

@@ -23,9 +23,12 @@ using sdpslam::io::LogReaderOptions;
 
 namespace {
 
+// The bag plugin is loaded before any test runs: the ROS libraries' statics it brings
+// would otherwise be blamed on the first test that opens a bag.
 const bool kBagsEnabled = [] {
   sdpslam::io::enable_bag_formats();
-  return true;
+  std::string error;
+  return sdpslam::io::load_bag_plugin(&error);
 }();
 
 LogContents read_shared(const std::string& name) {

@@ -51,9 +51,10 @@ bool looks_like_rosbag(const std::string& path);
 bool looks_like_ros2_bag(const std::string& path);
 
 // What LogReader opens a bag with: set by enable_bag_formats() (sdpslam_io_bags); null
-// in a program that reads no bags.
+// in a program that reads no bags. A maker returns null, with the reason in *error, when
+// the bag plugin cannot be loaded.
 class BagSource;
-using BagSourceMaker = std::unique_ptr<BagSource> (*)();
+using BagSourceMaker = std::unique_ptr<BagSource> (*)(std::string* error);
 extern BagSourceMaker g_make_ros1_source;
 extern BagSourceMaker g_make_ros2_source;
 
@@ -114,5 +115,35 @@ class BagSource {
   std::uint64_t scans_read_ = 0U;
   BagAssembler assembler_;
 };
+
+// A log written as a bag (the ROS 2 writer behind io::Ros2BagWriter, sdpslam/io/bags.h,
+// whose functions these are).
+class BagWriter {
+ public:
+  virtual ~BagWriter() = default;  // abandons (removes) an unclosed bag
+  virtual bool open(const std::string& folder, std::string* error) = 0;
+  virtual void odom(const OdomRecord& r) = 0;
+  virtual bool laser(const LaserRecord& r, std::string* error) = 0;
+  virtual std::uint64_t scans_written() const = 0;
+  virtual std::uint64_t scans_without_odometry() const = 0;
+  virtual bool close(std::string* error) = 0;
+};
+
+// The bag plugin, sdpslam_bags.so (bag_plugin.cpp): the bag readers and writer with the
+// ROS libraries they need, loaded by the program the first time it meets a bag, so that a
+// run on any other log maps none of those libraries (they hold several MiB resident).
+// The program and the plugin share these C++ types, so they must come from one build:
+// `build` is compared with the program's own kBagPluginBuild before anything is used.
+struct BagPlugin {
+  const char* build;
+  std::unique_ptr<BagSource> (*make_ros1_source)();
+  std::unique_ptr<BagSource> (*make_ros2_source)();
+  std::unique_ptr<BagWriter> (*make_ros2_writer)();
+  bool ros2_supported;  // built with libsqlite3 and Fast-CDR (else its makers refuse)
+};
+// The file (found through the program's run path), and its one exported function.
+constexpr const char* kBagPluginFile = "sdpslam_bags.so";
+constexpr const char* kBagPluginEntry = "sdpslam_bag_plugin_v1";
+using BagPluginEntry = const BagPlugin* (*)();
 
 }  // namespace sdpslam::io::detail

@@ -507,8 +507,8 @@ bool LogReader::open(const std::string& path, const LogReaderOptions& options, s
              " bag, and this program reads no bags (the sdpslam command does)";
       return false;
     }
-    impl_->bag = make();
-    if (!impl_->bag->open(path, options, err)) return false;
+    impl_->bag = make(err);
+    if (impl_->bag == nullptr || !impl_->bag->open(path, options, err)) return false;
     impl_->format = format;
     return true;
   }

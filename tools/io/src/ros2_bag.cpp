@@ -1,4 +1,5 @@
-// ROS 2 bags through libsqlite3 and Fast-CDR (ros2_bag.h, ros2_bag_source.h).
+// ROS 2 bags through libsqlite3 and Fast-CDR (sdpslam/io/bags.h, ros2_bag_source.h); part of
+// the bag plugin (bag_common.h: BagPlugin).
 #include <fastcdr/Cdr.h>
 #include <fastcdr/FastBuffer.h>
 #include <sqlite3.h>
@@ -18,7 +19,6 @@
 
 #include "ros2_bag_source.h"
 #include "sdpslam/io/atomic_file.h"
-#include "sdpslam/io/bags.h"
 
 namespace sdpslam::io {
 namespace fs = std::filesystem;
@@ -221,11 +221,11 @@ struct Statement {
 
 }  // namespace
 
-bool ros2_bags_supported() { return true; }
-
 // --- writer ---------------------------------------------------------------------------
 
-struct Ros2BagWriter::Impl {
+namespace {
+
+struct WriterState {
   std::string folder;
   std::string partial;
   std::string db_name;
@@ -261,22 +261,37 @@ struct Ros2BagWriter::Impl {
   }
 };
 
-Ros2BagWriter::Ros2BagWriter() : impl_(std::make_unique<Impl>()) {}
+class Ros2Writer final : public detail::BagWriter {
+ public:
+  Ros2Writer() = default;
+  Ros2Writer(const Ros2Writer&) = delete;
+  Ros2Writer& operator=(const Ros2Writer&) = delete;
+  ~Ros2Writer() override;
+  bool open(const std::string& folder, std::string* error) override;
+  void odom(const OdomRecord& r) override;
+  bool laser(const LaserRecord& r, std::string* error) override;
+  std::uint64_t scans_written() const override { return state_.scans; }
+  std::uint64_t scans_without_odometry() const override { return state_.without_odom; }
+  bool close(std::string* error) override;
 
-Ros2BagWriter::~Ros2BagWriter() {
-  if (impl_->open) {
-    impl_->insert = Statement();
-    if (impl_->db.db != nullptr) {
-      sqlite3_close(impl_->db.db);
-      impl_->db.db = nullptr;
+ private:
+  WriterState state_;
+};
+
+Ros2Writer::~Ros2Writer() {
+  if (state_.open) {
+    state_.insert = Statement();
+    if (state_.db.db != nullptr) {
+      sqlite3_close(state_.db.db);
+      state_.db.db = nullptr;
     }
     std::error_code ec;
-    fs::remove_all(impl_->partial, ec);
+    fs::remove_all(state_.partial, ec);
   }
 }
 
-bool Ros2BagWriter::open(const std::string& folder, std::string* error) {
-  Impl& s = *impl_;
+bool Ros2Writer::open(const std::string& folder, std::string* error) {
+  WriterState& s = state_;
   std::error_code ec;
   std::string name = fs::path(folder).filename().string();
   if (name.empty() || name == "." || name == "..") name = fs::path(folder).parent_path().filename().string();
@@ -324,13 +339,13 @@ bool Ros2BagWriter::open(const std::string& folder, std::string* error) {
   return true;
 }
 
-void Ros2BagWriter::odom(const OdomRecord& r) {
-  impl_->last_odom = r.pose;
-  impl_->have_odom = true;
+void Ros2Writer::odom(const OdomRecord& r) {
+  state_.last_odom = r.pose;
+  state_.have_odom = true;
 }
 
-bool Ros2BagWriter::laser(const LaserRecord& r, std::string* error) {
-  Impl& s = *impl_;
+bool Ros2Writer::laser(const LaserRecord& r, std::string* error) {
+  WriterState& s = state_;
   Pose2 odom = s.last_odom;
   if (r.has_odom_pose) {
     odom = r.odom_pose;
@@ -361,11 +376,8 @@ bool Ros2BagWriter::laser(const LaserRecord& r, std::string* error) {
   return true;
 }
 
-std::uint64_t Ros2BagWriter::scans_written() const { return impl_->scans; }
-std::uint64_t Ros2BagWriter::scans_without_odometry() const { return impl_->without_odom; }
-
-bool Ros2BagWriter::close(std::string* error) {
-  Impl& s = *impl_;
+bool Ros2Writer::close(std::string* error) {
+  WriterState& s = state_;
   if (!s.open) {
     *error = "the bag is not open";
     return false;
@@ -409,6 +421,13 @@ bool Ros2BagWriter::close(std::string* error) {
   const std::string parent = fs::path(s.folder).has_parent_path() ? fs::path(s.folder).parent_path().string() : ".";
   return fsync_directory(parent, error);
 }
+
+}  // namespace
+
+namespace detail {
+std::unique_ptr<BagWriter> make_ros2_writer() { return std::make_unique<Ros2Writer>(); }
+bool ros2_bags_built() { return true; }
+}  // namespace detail
 
 // --- reader ---------------------------------------------------------------------------
 

@@ -1,33 +1,34 @@
 // A build without ROS 2 bag support (tools/io/CMakeLists.txt: libsqlite3 or Fast-CDR was
 // not found): bags are recognised and refused with what to install.
 #include "ros2_bag_source.h"
-#include "sdpslam/io/bags.h"
 
-namespace sdpslam::io {
+namespace sdpslam::io::detail {
 namespace {
+
 const char* const kWhy =
     "this sdpslam was built without ROS 2 bag support (Debian: libsqlite3-dev libfastcdr-dev, then configure again)";
+
+class RefusingWriter final : public BagWriter {
+ public:
+  bool open(const std::string& folder, std::string* error) override {
+    *error = folder + ": " + kWhy;
+    return false;
+  }
+  void odom(const OdomRecord&) override {}
+  bool laser(const LaserRecord&, std::string*) override { return false; }
+  std::uint64_t scans_written() const override { return 0U; }
+  std::uint64_t scans_without_odometry() const override { return 0U; }
+  bool close(std::string* error) override {
+    *error = kWhy;
+    return false;
+  }
+};
+
 }  // namespace
 
-bool ros2_bags_supported() { return false; }
+std::unique_ptr<BagWriter> make_ros2_writer() { return std::make_unique<RefusingWriter>(); }
+bool ros2_bags_built() { return false; }
 
-struct Ros2BagWriter::Impl {};
-Ros2BagWriter::Ros2BagWriter() = default;
-Ros2BagWriter::~Ros2BagWriter() = default;
-bool Ros2BagWriter::open(const std::string& folder, std::string* error) {
-  *error = folder + ": " + kWhy;
-  return false;
-}
-void Ros2BagWriter::odom(const OdomRecord&) {}
-bool Ros2BagWriter::laser(const LaserRecord&, std::string*) { return false; }
-std::uint64_t Ros2BagWriter::scans_written() const { return 0U; }
-std::uint64_t Ros2BagWriter::scans_without_odometry() const { return 0U; }
-bool Ros2BagWriter::close(std::string* error) {
-  *error = kWhy;
-  return false;
-}
-
-namespace detail {
 struct Ros2BagSource::Impl {};
 Ros2BagSource::Ros2BagSource() = default;
 Ros2BagSource::~Ros2BagSource() = default;
@@ -36,6 +37,5 @@ bool Ros2BagSource::open(const std::string& path, const LogReaderOptions&, std::
   return false;
 }
 BagSource::Got Ros2BagSource::next(LaserRecord*, std::string*, bool*, std::int64_t*) { return Got::kEnd; }
-}  // namespace detail
 
-}  // namespace sdpslam::io
+}  // namespace sdpslam::io::detail

@@ -29,4 +29,9 @@ class Ros2BagSource final : public BagSource {
   std::unique_ptr<Impl> impl_;
 };
 
+// The writer behind io::Ros2BagWriter (ros2_bag.cpp), and whether this build has ROS 2
+// bags at all (false: ros2_bag_none.cpp, whose reader and writer refuse with what to install).
+std::unique_ptr<BagWriter> make_ros2_writer();
+bool ros2_bags_built();
+
 }  // namespace sdpslam::io::detail

@@ -3,8 +3,13 @@
 // the robot program, which reads no bags and links none of their libraries): after
 // enable_bag_formats(), LogReader reads ROS 1 bags (src/rosbag_source.h) and ROS 2 bags
 // (src/ros2_bag_source.h); before it, or in a program without it, a bag is refused.
-// Each kind needs its Debian packages at build time (tools/io/CMakeLists.txt); a build
-// without them refuses that kind with what to install.
+//
+// The readers and the writer, with the ROS libraries they need, live in a plugin,
+// sdpslam_bags.so (src/bag_common.h: BagPlugin), installed beside the program's libraries
+// in LIBDIR/sdpslam and loaded the first time a bag is opened: a run on any other log
+// maps none of those libraries. A missing plugin, or one from another build, is refused
+// with what went wrong. Each kind of bag needs its Debian packages at build time
+// (tools/io/CMakeLists.txt); a build without them refuses that kind with what to install.
 //
 // ROS 2 bags (rosbag2, SQLite 3 storage): a folder holding metadata.yaml and
 // NAME_0.db3, messages serialised as CDR (little-endian XCDR1, as rmw_fastrtps writes
@@ -31,8 +36,15 @@
 
 namespace sdpslam::io {
 
+namespace detail {
+class BagWriter;
+}
+
 void enable_bag_formats();
-bool ros2_bags_supported();  // built with libsqlite3 and Fast-CDR
+// Loads the plugin now rather than at the first bag (a program that wants its
+// allocations made early, or to report a broken install at start); false with the reason.
+bool load_bag_plugin(std::string* error);
+bool ros2_bags_supported();  // the plugin loads and was built with libsqlite3 and Fast-CDR
 
 class Ros2BagWriter {
  public:
@@ -52,8 +64,7 @@ class Ros2BagWriter {
   bool close(std::string* error);
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<detail::BagWriter> impl_;  // from the plugin, at open()
 };
 
 }  // namespace sdpslam::io
