@@ -42,23 +42,6 @@ struct Hole {
   std::uint64_t bytes;
 };
 
-// Reads into nothing: the bytes of a hole in the stream.
-class Discard {
- public:
-  explicit Discard(StateIo& io) : io_(io) {}
-  void skip(std::uint64_t n) {
-    unsigned char chunk[256];
-    while (n > 0U && io_.ok()) {
-      const std::size_t k = n < sizeof chunk ? static_cast<std::size_t>(n) : sizeof chunk;
-      io_.bytes(chunk, k);
-      n -= k;
-    }
-  }
-
- private:
-  StateIo& io_;
-};
-
 }  // namespace
 
 std::uint64_t SdpSlam::state_bytes() const {
@@ -134,7 +117,6 @@ void SdpSlam::transfer_state(StateIo& io) {
   // ---- region
   io.section("arena");
   std::uint64_t at = 0U;
-  Discard discard(io);
   for (const Hole& h : holes) {
     if (h.offset < at || h.offset + h.bytes > region) {
       io.fail("engine objects outside the arena region", nullptr);
@@ -142,17 +124,12 @@ void SdpSlam::transfer_state(StateIo& io) {
     }
     io.bytes(state_begin_ + at, static_cast<std::size_t>(h.offset - at));
     // The object's bytes travel as its members below; the stream keeps the place so
-    // that the region's offsets read straight.
-    if (io.saving()) {
-      unsigned char zeros[256] = {};
-      std::uint64_t n = h.bytes;
-      while (n > 0U && io.ok()) {
-        const std::size_t k = n < sizeof zeros ? static_cast<std::size_t>(n) : sizeof zeros;
-        io.bytes(zeros, k);
-        n -= k;
-      }
-    } else {
-      discard.skip(h.bytes);
+    // that the region's offsets read straight: zeros are written, and read into scratch.
+    unsigned char hole[256] = {};
+    for (std::uint64_t n = h.bytes; n > 0U && io.ok();) {
+      const std::size_t k = n < sizeof hole ? static_cast<std::size_t>(n) : sizeof hole;
+      io.bytes(hole, k);
+      n -= k;
     }
     at = h.offset + h.bytes;
   }

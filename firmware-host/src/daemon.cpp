@@ -156,7 +156,7 @@ void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
       PoseRecord rec;
       rec.flags = static_cast<std::uint16_t>((s.processed ? PoseRecord::kFlagProcessed : 0U) |
                                              (std::strcmp(io_.engine->name(), "localize") == 0 ? PoseRecord::kFlagLocalize : 0U));
-      rec.map_version = map_version_;
+      rec.map_version = map_version();
       rec.stamp_us = p.scan.stamp_us;
       rec.pose = s.pose;
       const PoseSpread spread = io_.engine->spread();
@@ -438,7 +438,6 @@ bool Daemon::write_outputs() {
   if (dt > counters_.max_output_write_us) counters_.max_output_write_us = dt;
   if (changed && ok) {
     ++counters_.output_writes;
-    if (config_.write_map) ++map_version_;
     written_at_scans_ = counters_.scans_placed;
   } else if (changed) {
     ++counters_.output_failures;
@@ -561,7 +560,7 @@ std::string Daemon::status_json() const {
                        {"subscribes", ps.subscribes},
                        {"subscribers_refused", ps.subscribers_refused},
                        {"subscribers_lost", ps.subscribers_lost},
-                       {"map_version", map_version_}};
+                       {"map_version", map_version()}};
   js["engine"] = io_.engine->status_json();
   js["outputs"] = {{"writes", c.output_writes},
                    {"failures", c.output_failures},

@@ -167,6 +167,11 @@ class Daemon {
   const OdometryRing& odometry_ring() const { return ring_; }
   const InputRecorder& input_recorder() const { return recorder_; }
   const PosePublisher& pose_publisher() const { return publisher_; }
+  // Map deliveries so far (PoseRecord::map_version): every delivered set holds the map
+  // when [output] write_map is on.
+  std::uint32_t map_version() const {
+    return config_.write_map ? static_cast<std::uint32_t>(counters_.output_writes) : 0U;
+  }
   const hal::OdometryReading odometry() const { return odom_.latest(); }
   std::string status_json() const;
   std::size_t queued_scans() const { return queue_.size(); }
@@ -201,7 +206,6 @@ class Daemon {
   RangeScan scratch_;
   InputRecorder recorder_;
   PosePublisher publisher_;
-  std::uint32_t map_version_ = 0U;  // map deliveries so far (PoseRecord::map_version)
   io::OutputSet outputs_;  // trajectory and map, delivered together (manifest.txt)
   std::uint64_t written_at_scans_ = ~std::uint64_t{0};  // scans_placed at the last delivered set
   RangeScan slam_scan_;  // the placed scan as SLAM gets it (InputRecorder::pass)
