@@ -376,8 +376,10 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
   const double off_x = (fig_w - draw_w) / 2.0;
   const double off_y = kTop;
 
-  // The map at one pixel per cell, grey as map_server reads it (unknown 205), north up.
-  Surface raster(cairo_image_surface_create(CAIRO_FORMAT_RGB24, mw, mh));
+  // The map at one pixel per cell, grey as map_server reads it (unknown 205), north up: as
+  // an 8-bit mask of darkness (255 - grey) that paints black over the white figure, which
+  // gives the grey back exactly, in a quarter of an RGB raster's memory.
+  Surface raster(cairo_image_surface_create(CAIRO_FORMAT_A8, mw, mh));
   if (cairo_surface_status(raster.get()) != CAIRO_STATUS_SUCCESS) {
     if (error != nullptr) *error = "cannot draw '" + path + "': " + cairo_status_to_string(cairo_surface_status(raster.get()));
     return false;
@@ -386,13 +388,13 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
   unsigned char* px = cairo_image_surface_get_data(raster.get());
   const int stride = cairo_image_surface_get_stride(raster.get());
   for (int row = 0; row < mh; ++row) {
-    auto* out = reinterpret_cast<std::uint32_t*>(px + static_cast<std::ptrdiff_t>(row) * stride);
+    unsigned char* out = px + static_cast<std::ptrdiff_t>(row) * stride;
     const std::size_t src = static_cast<std::size_t>(mh - 1 - row) * m->width;
     for (int col = 0; col < mw; ++col) {
       const float p = m->occupancy[src + static_cast<std::size_t>(col)];
-      std::uint32_t g = 205U;
-      if (p >= 0.0F) g = static_cast<std::uint32_t>(std::lround((1.0 - std::min(1.0, static_cast<double>(p))) * 255.0));
-      out[col] = (g << 16U) | (g << 8U) | g;
+      long g = 205;
+      if (p >= 0.0F) g = std::lround((1.0 - std::min(1.0, static_cast<double>(p))) * 255.0);
+      out[col] = static_cast<unsigned char>(255 - g);
     }
   }
   cairo_surface_mark_dirty(raster.get());
@@ -405,10 +407,13 @@ bool write_map_figure_png(const std::string& path, const io::MapFigure& f, std::
   cairo_save(c);
   cairo_translate(c, off_x, off_y);
   cairo_scale(c, static_cast<double>(draw_w) / mw, static_cast<double>(draw_h) / mh);
-  cairo_set_source_surface(c, raster.get(), 0.0, 0.0);
-  cairo_pattern_set_filter(cairo_get_source(c), scale < 1.0 ? CAIRO_FILTER_GOOD : CAIRO_FILTER_NEAREST);
-  cairo_paint(c);
+  cairo_set_source_rgb(c, 0.0, 0.0, 0.0);
+  cairo_pattern_t* mask = cairo_pattern_create_for_surface(raster.get());
+  cairo_pattern_set_filter(mask, scale < 1.0 ? CAIRO_FILTER_GOOD : CAIRO_FILTER_NEAREST);
+  cairo_mask(c, mask);
+  cairo_pattern_destroy(mask);
   cairo_restore(c);
+  raster = Surface();  // the figure holds the map now
 
   const double px_per_m = static_cast<double>(draw_w) / (mw * m->resolution_m);
   auto u = [&](double x_m) { return off_x + (x_m - m->origin_x_m) * px_per_m; };
