@@ -234,7 +234,7 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
 
 std::function<int()> setup_run(CLI::App& app) {
   auto args = std::make_shared<RunArgs>();
-  app.add_option("log", args->log, "Robot log (CARMEN .clf[.gz], tinySLAM .dat, DP-SLAM .log, ROS 1 .bag)")->required();
+  app.add_option("log", args->log, "Robot log (CARMEN .clf[.gz], tinySLAM .dat, DP-SLAM .log, ROS 1 .bag, ROS 2 bag folder or .db3)")->required();
   app.add_option("--mode", args->mode,
                  "Algorithm: sdp (Segmented DP-SLAM, default) or dpslam (the bottom-level DP-SLAM filter alone)")
       ->check(CLI::IsMember({"sdp", "dpslam"}))
