@@ -8,8 +8,9 @@
 # segments, permanent levels and loop closures. Kill times step through a range so that
 # the stops fall in different places on any machine (the run takes about 4 s here with
 # its snapshots); an attempt killed before its first snapshot starts again from the
-# previous one, and after twelve attempts the run is left to finish, so that a slow
-# machine (a sanitizer build) ends too.
+# previous one. After twelve attempts the run is left to finish once a snapshot exists;
+# until then (a slow machine: a sanitizer build on a loaded host) each limit doubles, so
+# that the test still kills, resumes and ends.
 set -u
 sdpslam=$1 work=$2
 rm -rf "$work" && mkdir -p "$work"
@@ -23,8 +24,12 @@ while :; do
   attempt=$((attempt + 1))
   resume=""
   if [ -f "$snap" ]; then resume="--resume $snap"; resumes=$((resumes + 1)); fi
-  # 1 s, 1.5 s, ... 3.5 s, twice over, then no limit.
-  limit=$(awk -v a="$attempt" 'BEGIN { printf "%.1f", (a > 12 ? 0 : 1.0 + 0.5 * ((a - 1) % 6)) }')
+  # 1 s, 1.5 s, ... 3.5 s, twice over; then no limit once a snapshot exists, 7 s, 14 s,
+  # ... until one does.
+  limit=$(awk -v a="$attempt" -v have="$([ -f "$snap" ] && echo 1 || echo 0)" 'BEGIN {
+    if (a <= 12) printf "%.1f", 1.0 + 0.5 * ((a - 1) % 6);
+    else if (have) printf "0";
+    else printf "%.1f", 3.5 * 2 ^ (a - 12) }')
   # shellcheck disable=SC2086
   timeout -s KILL "$limit" "$sdpslam" run "$log" --seed 3 --quiet --out "$work/resumed" \
     --snapshot "$snap" --snapshot-every-s 30 $resume >"$work/attempt.log" 2>&1
