@@ -301,28 +301,44 @@ TEST(SdpSlam, loop_closure_adjusts_the_frames_and_the_permanent_path_follows) {
 }
 
 // A small ring of permanent submaps forgets the oldest; their cells stay where they were
-// copied while the held ones move with their frames, and the drawn map still agrees
-// with the path better than the map as copied. The DP map's pool is the bottom
-// options' (short of room for every live level), so levels become permanent early and
-// many are forgotten.
+// copied while the held ones move with their frames, and over a few seeds the drawn map
+// agrees with the path better than the map as copied (one run may end with its held
+// frames where they were copied: then the two drawings are the same map). The DP map's
+// pool is the bottom options' (short of room for every live level), so levels become
+// permanent early and many are forgotten.
 TEST(SdpSlam, forgotten_permanent_levels_stay_where_they_were_copied) {
   const test::ScanSet set(3);
   SdpOptions s = test::small_sdp_options();
   s.loop_closure = true;
   s.max_permanent_submaps = 8U;
   s.map_observation_capacity = 0U;  // the bottom options' size
-  test::SdpRig a;
-  CHECK_TRUE(a.init(test::sim_options(5), s, 21));
-  test::CollectPoses sa;
-  run_sdp(a, set, &sa);
-  const SdpStats& st = a.slam->stats();
-  CHECK(st.permanent_forgotten > 0U);
-  CHECK(st.permanent_map_offset_m > 0.0);
-  const double drawn = permanent_map_agreement(*a.slam, set, sa, true);
-  const double as_copied = permanent_map_agreement(*a.slam, set, sa, false);
-  std::printf("\n  %llu permanent levels forgotten; laser returns on the walls: %.3f drawn, %.3f as copied\n",
-              static_cast<unsigned long long>(st.permanent_forgotten), drawn, as_copied);
-  CHECK(drawn > as_copied);
+  double drawn_sum = 0.0;
+  double copied_sum = 0.0;
+  std::uint32_t moved_runs = 0U;
+  std::printf("\n");
+  for (std::uint64_t seed = 21U; seed <= 25U; ++seed) {
+    test::SdpRig a;
+    CHECK_TRUE(a.init(test::sim_options(5), s, seed));
+    test::CollectPoses sa;
+    run_sdp(a, set, &sa);
+    const SdpStats& st = a.slam->stats();
+    CHECK(st.permanent_forgotten > 0U);
+    const double drawn = permanent_map_agreement(*a.slam, set, sa, true);
+    const double as_copied = permanent_map_agreement(*a.slam, set, sa, false);
+    std::printf("  seed %llu: %llu permanent levels forgotten, held ones moved %.3f m; laser returns on the walls: "
+                "%.3f drawn, %.3f as copied\n",
+                static_cast<unsigned long long>(seed), static_cast<unsigned long long>(st.permanent_forgotten),
+                st.permanent_map_offset_m, drawn, as_copied);
+    if (st.permanent_map_offset_m > 0.0) {
+      ++moved_runs;
+    } else {
+      DOUBLES_EQUAL(as_copied, drawn, 0.0);
+    }
+    drawn_sum += drawn;
+    copied_sum += as_copied;
+  }
+  CHECK(moved_runs > 0U);
+  CHECK(drawn_sum > copied_sum);
 }
 
 // Beyond the paper: the wide loop search finds constraints the top level's ICP cannot
@@ -565,8 +581,12 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
   SdpOptions s = test::small_sdp_options();
   std::uint32_t peak = 0U;
   {
+    // The reference: a pool with room to spare, so that no level goes for room (not even
+    // ahead of time, which a pool near full at a segment's peak would ask for).
+    SdpOptions ample = s;
+    ample.map_observation_capacity = 2U * s.map_observation_capacity;
     test::SdpRig rig;
-    CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+    CHECK_TRUE(rig.init(test::sim_options(5), ample, 5));
     test::CollectPoses sink;
     run_sdp(rig, set, &sink);
     const DpMap& map = rig.slam->bottom().map();
