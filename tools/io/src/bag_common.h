@@ -133,7 +133,7 @@ class BagWriter {
 // ROS libraries they need, loaded by the program the first time it meets a bag, so that a
 // run on any other log maps none of those libraries (they hold several MiB resident).
 // The program and the plugin share these C++ types, so they must come from one build:
-// `build` is compared with the program's own kBagPluginBuild before anything is used.
+// `build` is compared with the program's own SDPSLAM_BAG_PLUGIN_BUILD before anything is used.
 struct BagPlugin {
   const char* build;
   std::unique_ptr<BagSource> (*make_ros1_source)();

@@ -101,29 +101,22 @@ const Loaded& loaded() {
   return l;
 }
 
-std::unique_ptr<detail::BagSource> make_ros1(std::string* error) {
+// A reader from the plugin, loaded at the first call; the error says why there is none.
+template <std::unique_ptr<detail::BagSource> (*detail::BagPlugin::*Make)()>
+std::unique_ptr<detail::BagSource> make_source(std::string* error) {
   const Loaded& l = loaded();
   if (l.plugin == nullptr) {
     *error = l.error;
     return nullptr;
   }
-  return l.plugin->make_ros1_source();
-}
-
-std::unique_ptr<detail::BagSource> make_ros2(std::string* error) {
-  const Loaded& l = loaded();
-  if (l.plugin == nullptr) {
-    *error = l.error;
-    return nullptr;
-  }
-  return l.plugin->make_ros2_source();
+  return (l.plugin->*Make)();
 }
 
 }  // namespace
 
 void enable_bag_formats() {
-  detail::g_make_ros1_source = &make_ros1;
-  detail::g_make_ros2_source = &make_ros2;
+  detail::g_make_ros1_source = &make_source<&detail::BagPlugin::make_ros1_source>;
+  detail::g_make_ros2_source = &make_source<&detail::BagPlugin::make_ros2_source>;
 }
 
 bool load_bag_plugin(std::string* error) {
