@@ -1,0 +1,167 @@
+// Along-track bias of the bottom level's observation model (core/bottom/beam_model.h).
+// A plain program (not a test) that prints figures; build it in a Release directory:
+//   cmake --build --preset host-release --target bench_beam_bias
+//   build/host-release/tests/dpslam_filter/bench_beam_bias
+//
+// A robot drives straight down a 3 m corridor in 0.2 m steps; exact scans (181 beams over
+// 180 deg, 1 cm range noise) are written into one lineage of the DP map from the TRUE
+// poses. Before each scan is written, its log-likelihood is profiled along the corridor
+// around the true pose (+-5 cm in 2.5 mm steps) and the offset of the maximum recorded.
+// An unbiased model peaks at 0 on average; a negative mean means the model places the
+// robot behind where it is, and a filter that follows it shortens every path by about
+// (mean offset / step) — even with perfect odometry. The laser faces forward, so a model
+// that sees surfaces nearer than they are pulls every match back.
+// Rows: plain walls (only the corridor's end walls constrain the motion along it) or
+// walls with door recesses every 3 m; laser reach 8 m or 30 m; corridor along the grid
+// or turned 0.3 rad to it; the map written from the poses behind the robot only (as in
+// SLAM) or from every pose of the run first (every viewpoint).
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "sdpslam/core/bottom/beam_model.h"
+#include "sdpslam/core/dpslam_options.h"
+#include "sim_world.h"
+
+namespace {
+
+using namespace sdpslam;
+
+struct Case {
+  bool doors;
+  double reach_m;
+  double heading_rad;
+  bool every_viewpoint;
+};
+
+std::vector<test::Segment> corridor(bool doors, double heading_rad, double length_m) {
+  std::vector<test::Segment> w;
+  const double c = std::cos(heading_rad);
+  const double s = std::sin(heading_rad);
+  auto add = [&](double x0, double y0, double x1, double y1) {
+    w.push_back({x0 * c - y0 * s, x0 * s + y0 * c, x1 * c - y1 * s, x1 * s + y1 * c});
+  };
+  const double half = 1.5;
+  if (!doors) {
+    add(-2.0, -half, length_m, -half);
+    add(-2.0, half, length_m, half);
+  } else {
+    // A 1 m recess (0.5 m deep) on the right and a 1 m recess (0.4 m deep) on the left every 3 m.
+    for (double x = -2.0; x < length_m; x += 3.0) {
+      add(x, -half, x + 2.0, -half);
+      add(x + 2.0, -half, x + 2.0, -half - 0.5);
+      add(x + 2.0, -half - 0.5, x + 3.0, -half - 0.5);
+      add(x + 3.0, -half - 0.5, x + 3.0, -half);
+      add(x + 1.0, half, x + 3.0, half);
+      add(x + 1.0, half, x + 1.0, half + 0.4);
+      add(x, half + 0.4, x + 1.0, half + 0.4);
+      add(x, half + 0.4, x, half);
+    }
+  }
+  add(length_m, -half - 1.0, length_m, half + 1.0);
+  add(-2.0, -half - 1.0, -2.0, half + 1.0);
+  return w;
+}
+
+struct Result {
+  double mean_m = 0.0;
+  double mean_abs_m = 0.0;
+  int scans = 0;
+};
+
+bool run_case(const Case& k, Result* out) {
+  constexpr double kLength = 60.0;
+  constexpr double kStep = 0.2;
+  const std::vector<test::Segment> world = corridor(k.doors, k.heading_rad, kLength);
+  DpMap::Options mo;
+  mo.origin_x_m = -10.0;
+  mo.origin_y_m = -10.0;
+  mo.width_m = 80.0;
+  mo.height_m = 40.0;
+  mo.resolution_m = 0.05;
+  mo.tile_capacity = 6000U;
+  mo.observation_capacity = 2000000U;
+  std::vector<unsigned char> buffer(AncestryTree::required_arena_bytes(4, 4) + DpMap::required_arena_bytes(mo, 4) + 4096U);
+  Arena arena;
+  arena.reset(buffer.data(), buffer.size());
+  AncestryTree tree;
+  DpMap map;
+  BeamModel beam;
+  const DpSlamOptions defaults;
+  if (!tree.init(arena, 4, 4) || !map.init(arena, mo, tree) || !beam.init(defaults.beam, mo.resolution_m)) return false;
+  const NodeId lineage = tree.create_root();
+  auto scan = std::make_unique<RangeScan>();
+  auto rays = std::make_unique<ScanRays>();
+  Rng noise(5U);
+  const double c = std::cos(k.heading_rad);
+  const double s = std::sin(k.heading_rad);
+  auto pose_at = [&](double along_m) { return Pose2{along_m * c, along_m * s, k.heading_rad}; };
+  auto make = [&](const Pose2& truth) {
+    test::make_scan(world, truth, 0, scan.get(), &noise, 0.01);
+    for (std::uint32_t i = 0; i < scan->beam_count; ++i) {
+      if (static_cast<double>(scan->ranges_m[i]) >= k.reach_m) scan->ranges_m[i] = scan->geometry.range_max_m;  // no return
+    }
+    prepare_rays(*scan, rays.get());
+  };
+  const int steps = static_cast<int>((kLength - 20.0) / kStep);
+  if (k.every_viewpoint) {
+    for (int i = 0; i < steps; ++i) {
+      make(pose_at(kStep * i));
+      beam.update_map(map, lineage, *rays, pose_at(kStep * i));
+    }
+  }
+  double sum = 0.0;
+  double sum_abs = 0.0;
+  int n = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double along = kStep * i;
+    make(pose_at(along));
+    if (along > 5.0) {  // some map behind the robot first
+      double best = -1e300;
+      double best_offset = 0.0;
+      for (int j = -20; j <= 20; ++j) {
+        const double offset = 0.0025 * j;
+        const double ll = beam.log_likelihood_strided(map, lineage, *rays, pose_at(along + offset), 1U, nullptr);
+        if (ll > best) {
+          best = ll;
+          best_offset = offset;
+        }
+      }
+      sum += best_offset;
+      sum_abs += std::fabs(best_offset);
+      ++n;
+    }
+    if (!k.every_viewpoint) beam.update_map(map, lineage, *rays, pose_at(along));
+  }
+  out->mean_m = n > 0 ? sum / n : 0.0;
+  out->mean_abs_m = n > 0 ? sum_abs / n : 0.0;
+  out->scans = n;
+  return true;
+}
+
+}  // namespace
+
+int main() {
+  std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per 0.2 m step | scans |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  int failed = 0;
+  for (bool doors : {false, true}) {
+    for (double reach : {8.0, 30.0}) {
+      for (double heading : {0.0, 0.3}) {
+        for (bool every : {false, true}) {
+          Result r;
+          if (!run_case(Case{doors, reach, heading, every}, &r)) {
+            ++failed;
+            continue;
+          }
+          std::printf("| %s | %.0f m | %.1f rad | %s | %+.1f mm | %.1f mm | %+.2f %% | %d |\n", doors ? "door recesses" : "plain",
+                      reach, heading, every ? "every pose" : "poses behind", r.mean_m * 1e3, r.mean_abs_m * 1e3,
+                      100.0 * r.mean_m / 0.2, r.scans);
+        }
+      }
+    }
+  }
+  if (failed > 0) std::fprintf(stderr, "bench_beam_bias: %d cases could not set up their map\n", failed);
+  return failed > 0 ? 1 : 0;
+}
