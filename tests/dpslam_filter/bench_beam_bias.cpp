@@ -28,6 +28,8 @@ namespace {
 
 using namespace sdpslam;
 
+constexpr double kStep_m = 0.2;  // travel between scans
+
 struct Case {
   bool doors;
   double reach_m;
@@ -72,7 +74,6 @@ struct Result {
 
 bool run_case(const Case& k, Result* out) {
   constexpr double kLength = 60.0;
-  constexpr double kStep = 0.2;
   const std::vector<test::Segment> world = corridor(k.doors, k.heading_rad, kLength);
   DpMap::Options mo;
   mo.origin_x_m = -10.0;
@@ -104,18 +105,18 @@ bool run_case(const Case& k, Result* out) {
     }
     prepare_rays(*scan, rays.get());
   };
-  const int steps = static_cast<int>((kLength - 20.0) / kStep);
+  const int steps = static_cast<int>((kLength - 20.0) / kStep_m);
   if (k.every_viewpoint) {
     for (int i = 0; i < steps; ++i) {
-      make(pose_at(kStep * i));
-      beam.update_map(map, lineage, *rays, pose_at(kStep * i));
+      make(pose_at(kStep_m * i));
+      beam.update_map(map, lineage, *rays, pose_at(kStep_m * i));
     }
   }
   double sum = 0.0;
   double sum_abs = 0.0;
   int n = 0;
   for (int i = 0; i < steps; ++i) {
-    const double along = kStep * i;
+    const double along = kStep_m * i;
     make(pose_at(along));
     if (along > 5.0) {  // some map behind the robot first
       double best = -1e300;
@@ -143,7 +144,8 @@ bool run_case(const Case& k, Result* out) {
 }  // namespace
 
 int main() {
-  std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per 0.2 m step | scans |\n");
+  std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per %.1f m step | scans |\n",
+              kStep_m);
   std::printf("|---|---|---|---|---|---|---|---|\n");
   int failed = 0;
   for (bool doors : {false, true}) {
@@ -157,7 +159,7 @@ int main() {
           }
           std::printf("| %s | %.0f m | %.1f rad | %s | %+.1f mm | %.1f mm | %+.2f %% | %d |\n", doors ? "door recesses" : "plain",
                       reach, heading, every ? "every pose" : "poses behind", r.mean_m * 1e3, r.mean_abs_m * 1e3,
-                      100.0 * r.mean_m / 0.2, r.scans);
+                      100.0 * r.mean_m / kStep_m, r.scans);
         }
       }
     }
