@@ -348,6 +348,11 @@ void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) con
 
 // ---- per scan -------------------------------------------------------------------------
 
+bool SdpSlam::relocate(const Pose2& delta) {
+  if (!initialised_ || !started_) return false;
+  return filter_->displace(delta);
+}
+
 SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan) {
   SdpStepResult result;
   if (!initialised_) return result;

@@ -2,6 +2,7 @@
 // no-motion rule, accuracy on a synthetic loop, determinism, and exhaustion.
 #include <CppUTest/TestHarness.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -91,6 +92,45 @@ TEST(DpSlamFilter, small_motion_is_not_processed_and_gets_the_odometry_pose) {
   DOUBLES_EQUAL(0.02, r.pose.heading_rad, 1e-12);
   LONGS_EQUAL(1, rig.filter->stats().processed);
   LONGS_EQUAL(2, rig.filter->stats().scans);
+}
+
+// A move odometry did not see (the robot carried while the program was off, then found
+// in the map): every particle moves rigidly by it, the next scan is processed although
+// the odometry shows no motion, and the lineage holds the step.
+TEST(DpSlamFilter, a_displacement_moves_every_particle_rigidly_and_the_next_scan_is_processed) {
+  FilterRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(4), 3));
+  const auto world = test::room_world();
+  const Pose2 delta{0.8, -0.3, 0.4};
+  CHECK_FALSE(rig.filter->displace(delta));  // nothing processed yet
+  test::make_scan(world, Pose2{}, 0, rig.scan.get());
+  OdometrySample od;
+  CHECK(rig.filter->process(od, *rig.scan).status == StepResult::Status::kProcessed);
+  od.pose = Pose2{0.3, 0.0, 0.0};
+  od.stamp_us = 100000;
+  test::make_scan(world, od.pose, od.stamp_us, rig.scan.get());
+  CHECK(rig.filter->process(od, *rig.scan).status == StepResult::Status::kProcessed);
+  std::vector<Pose2> before;
+  for (std::uint32_t i = 0; i < rig.filter->particle_count(); ++i) before.push_back(rig.filter->particle_pose(i));
+  CHECK_FALSE(rig.filter->displace(Pose2{std::nan(""), 0.0, 0.0}));
+  CHECK_TRUE(rig.filter->displace(delta));
+  for (std::uint32_t i = 0; i < rig.filter->particle_count(); ++i) {
+    const Pose2 want = before[i].compose(delta);
+    const Pose2 got = rig.filter->particle_pose(i);
+    CHECK(want.x_m == got.x_m && want.y_m == got.y_m && want.heading_rad == got.heading_rad);
+  }
+  // The same odometry again (no motion): processed, at the displaced place (the truth
+  // there), not skipped.
+  const Pose2 truth = od.pose.compose(delta);
+  od.stamp_us = 200000;
+  test::make_scan(world, truth, od.stamp_us, rig.scan.get());
+  const StepResult r = rig.filter->process(od, *rig.scan);
+  CHECK(r.status == StepResult::Status::kProcessed);
+  CHECK(std::hypot(r.pose.x_m - truth.x_m, r.pose.y_m - truth.y_m) < 0.1);
+  LONGS_EQUAL(3, rig.filter->stats().processed);
+  // And only that one: the scan after it, still without motion, is skipped again.
+  od.stamp_us = 300000;
+  CHECK(rig.filter->process(od, *rig.scan).status == StepResult::Status::kSkippedNoMotion);
 }
 
 namespace {

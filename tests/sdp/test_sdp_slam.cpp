@@ -547,6 +547,36 @@ TEST(SdpSlam, same_seed_gives_bit_identical_trajectories) {
   CHECK(a.slam->stats().error_sum_m == b.slam->stats().error_sum_m);
 }
 
+// relocate(): the robot's global estimate steps by the displacement (its own frame) and
+// goes on from there; refused before the first scan and for a non-finite move.
+TEST(SdpSlam, a_relocation_moves_the_global_estimate_by_the_displacement) {
+  const test::ScanSet set(1);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 21));
+  const Pose2 delta{1.5, 0.5, 0.3};
+  CHECK_FALSE(rig.slam->relocate(delta));
+  const std::size_t half = set.scans.size() / 2U;
+  for (std::size_t i = 0; i < half; ++i) rig.slam->process(set.odom(i), *set.scans[i]);
+  CHECK(rig.slam->stats().segments > 0U);  // across a segment boundary: the frames matter
+  const Pose2 before = rig.slam->current_frame().compose(rig.slam->bottom().best_pose());
+  CHECK_FALSE(rig.slam->relocate(Pose2{0.0, std::nan(""), 0.0}));
+  CHECK_TRUE(rig.slam->relocate(delta));
+  const Pose2 want = before.compose(delta);
+  const Pose2 after = rig.slam->current_frame().compose(rig.slam->bottom().best_pose());
+  DOUBLES_EQUAL(want.x_m, after.x_m, 1e-9);
+  DOUBLES_EQUAL(want.y_m, after.y_m, 1e-9);
+  DOUBLES_EQUAL(want.heading_rad, after.heading_rad, 1e-9);
+  // The next scan, its odometry unchanged, is placed there (the scan itself is the one
+  // seen before the move: the bottom filter's map has nothing at the new place yet).
+  OdometrySample od = set.odom(half - 1U);
+  od.stamp_us += 1;
+  auto scan = std::make_unique<RangeScan>(*set.scans[half - 1U]);
+  scan->stamp_us = od.stamp_us;
+  const SdpStepResult r = rig.slam->process(od, *scan);
+  CHECK(r.bottom.status == StepResult::Status::kProcessed);
+  CHECK(std::hypot(r.pose.x_m - want.x_m, r.pose.y_m - want.y_m) < 0.5);
+}
+
 TEST(SdpSlam, tiny_capacities_are_counted_and_survived) {
   const test::ScanSet set(2);
   DpSlamOptions b = test::sim_options(3);

@@ -1,5 +1,6 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "sdpslam/core/det_math.h"
@@ -179,7 +180,7 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   const Pose2 delta = between(last_odom_.pose, odom.pose);
   const double travel = det::sqrt(delta.x_m * delta.x_m + delta.y_m * delta.y_m);
   const double turn = delta.heading_rad < 0.0 ? -delta.heading_rad : delta.heading_rad;
-  if (travel < options_.update_min_travel_m && turn < options_.update_min_rotation_rad) {
+  if (!update_due_ && travel < options_.update_min_travel_m && turn < options_.update_min_rotation_rad) {
     result.status = StepResult::Status::kSkippedNoMotion;
     result.pose = last_best_pose_.compose(delta);
     return result;
@@ -266,6 +267,7 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   best_index_ = new_best;
   last_odom_ = odom;
   last_best_pose_ = proposed_[best];
+  update_due_ = false;
 
   ++stats_.processed;
   stats_.map_updates_dropped += dropped;
@@ -314,6 +316,15 @@ bool DpSlamFilter::is_particle_node(NodeId node) const {
     if (particles_[i].node == node) return true;
   }
   return false;
+}
+
+bool DpSlamFilter::displace(const Pose2& delta) {
+  if (!initialised_ || !started_) return false;
+  if (!(std::isfinite(delta.x_m) && std::isfinite(delta.y_m) && std::isfinite(delta.heading_rad))) return false;
+  for (std::uint32_t i = 0; i < particle_count_; ++i) particles_[i].pose = particles_[i].pose.compose(delta);
+  last_best_pose_ = last_best_pose_.compose(delta);
+  update_due_ = true;
+  return true;
 }
 
 bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
@@ -410,6 +421,7 @@ void DpSlamFilter::transfer_state(StateIo& io) {
   io.arena_pointer(next_, "filter next generation");
   io.value(best_index_);
   io.value(started_);
+  io.value(update_due_);
   io.value(last_odom_);
   io.value(last_best_pose_);
   io.value(restart_refused_count_);

@@ -201,6 +201,13 @@ class SdpSlam {
   // Completes pending anchorage work (skeletons, map transfer) at once, e.g. before the
   // outputs are read at the end of a run. Not bounded by the per-scan budget.
   void finish();
+  // The robot was moved by `delta` (its own frame at the last processed scan) where
+  // odometry could not see it, e.g. while the program was off (a resumed session whose
+  // first scan was found elsewhere in the saved map). The current segment's particles
+  // move rigidly (DpSlamFilter::displace): the segment's path steps by `delta` and goes
+  // on from there, so the global estimate continues at the place found. False,
+  // changing nothing, iff no scan was processed yet or `delta` is not finite.
+  bool relocate(const Pose2& delta);
 
   // Path of the segments made permanent (see SdpPathSink), in time order. Not owned.
   void set_permanent_sink(SdpPathSink* sink) { permanent_sink_ = sink; }

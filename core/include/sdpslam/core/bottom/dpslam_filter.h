@@ -128,6 +128,15 @@ class DpSlamFilter {
   // not processed a scan yet or the node pool cannot hold the root and the particles'
   // children (restart_refused_count() bumps). O(N + lineage depth + kSeedScans · beams).
   bool restart_segment(const Pose2& start_pose);
+  // The robot was moved by `delta` (in its own frame at the last processed scan) where
+  // odometry could not see it: carried while the program was off, found again in the
+  // saved map. Every particle and the best pose move rigidly, without motion noise (the
+  // move is a measurement, not a prediction); the next scan's odometry is taken relative
+  // to the last processed one as before, and that scan is processed whatever the motion
+  // (its pose, at the new place, is recorded on the lineages). The map and the lineages
+  // are unchanged until then: the move is the step between two recorded poses. False, changing nothing, iff no scan
+  // was processed yet or `delta` is not finite. O(N).
+  bool displace(const Pose2& delta);
   // Makes an anchored node inactive and prunes, so its observations and poses are freed
   // once nothing descends from it. False (nothing changes) iff `node` is dead or is the
   // node of a current particle. O(prune).
@@ -195,6 +204,7 @@ class DpSlamFilter {
 
   bool initialised_ = false;
   bool started_ = false;
+  bool update_due_ = false;            // the next scan is processed whatever the motion (displace())
   OdometrySample last_odom_{};         // odometry at the last processed scan
   Pose2 last_best_pose_{};             // best pose at the last processed scan
   std::uint32_t restart_refused_count_ = 0U;
