@@ -150,9 +150,13 @@ void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
                recorder_.stats().write_failures);
     }
     const EngineStep s = io_.engine->process(slam_odom, slam_scan_);
-    ++counters_.scans_placed;
+    if (const std::string notice = io_.engine->take_notice(); !notice.empty()) {
+      log_.log(Event::kStartup, "%s", notice.c_str());
+    }
+    if (s.placed) ++counters_.scans_placed;
+    else ++counters_.scans_held;
     if (s.processed) ++counters_.scans_processed;
-    if (publisher_.is_open()) {
+    if (publisher_.is_open() && s.placed) {
       PoseRecord rec;
       rec.flags = static_cast<std::uint16_t>((s.processed ? PoseRecord::kFlagProcessed : 0U) |
                                              (std::strcmp(io_.engine->name(), "localize") == 0 ? PoseRecord::kFlagLocalize : 0U));
@@ -500,6 +504,7 @@ std::string Daemon::status_json() const {
   js["scans"] = {{"received", c.scans_received},
                  {"placed", c.scans_placed},
                  {"processed", c.scans_processed},
+                 {"held", c.scans_held},
                  {"skipped_no_odometry", c.scans_skipped_no_odometry},
                  {"skipped_too_old", c.scans_skipped_too_old},
                  {"skipped_gap", c.scans_skipped_gap},

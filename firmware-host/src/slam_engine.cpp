@@ -6,6 +6,7 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/snapshot_file.h"
+#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/slam_outputs.h"
 
@@ -171,20 +172,28 @@ class SdpEngine final : public SlamEngine {
 
   const char* name() const override { return "sdp"; }
 
-  EngineStep process(const OdometrySample& odom_in, const RangeScan& scan) override {
-    // After a resume the encoders' odometry starts again from its own origin: it is
-    // carried into the snapshot's odometry frame so that the robot continues from where
-    // the session left it (it is taken not to have moved while sdpslamd was down; the
-    // scan matching absorbs a small move).
-    if (rebase_pending_) {
-      odom_offset_ = last_odom_.compose(odom_in.pose.inverse());
-      rebase_pending_ = false;
-      rebased_ = true;
-    }
+  EngineStep process(const OdometrySample& odom_in, const RangeScan& scan_in) override {
+    // After a resume the input does not follow the session without a break: its
+    // odometry starts from its own origin, its clock may have started again, and the
+    // robot may have been moved (slam/session_continuation.h carries all three across;
+    // the scan is copied into a buffer reserved at create time, as the stamp may move).
     OdometrySample odom = odom_in;
-    if (rebased_) odom.pose = odom_offset_.compose(odom_in.pose);
+    const RangeScan* scan = &scan_in;
+    if (continuation_.active()) {
+      *carried_ = scan_in;
+      scan = carried_.get();
+      const slam::ContinuationReport::Place before = continuation_.report().place;
+      const bool feed = continuation_.carry(&odom, carried_.get(), *slam_);
+      if (continuation_.report().place != before) notice_ = continuation_.report().describe();
+      if (!feed) {
+        EngineStep held;
+        held.placed = false;
+        held.pose = last_pose_;
+        return held;
+      }
+    }
     last_odom_ = odom.pose;
-    const SdpStepResult r = slam_->process(odom, scan);
+    const SdpStepResult r = slam_->process(odom, *scan);
     EngineStep s;
     s.processed = r.bottom.status == StepResult::Status::kProcessed;
     s.pose = r.pose;  // global frame, best top-level particle
@@ -192,6 +201,12 @@ class SdpEngine final : public SlamEngine {
     if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
     else ++unrecorded_;
     return s;
+  }
+
+  std::string take_notice() override {
+    std::string n;
+    n.swap(notice_);
+    return n;
   }
 
   // The bottom-level particles live in the segment's frame: turned into the map frame by
@@ -222,6 +237,7 @@ class SdpEngine final : public SlamEngine {
     // The offline runner's stats.json members; trajectory gaps and known cells as of the
     // last trajectory() / map_image().
     js.update(slam::sdp_state_json(*slam_, arena_bytes_, arena_->used_bytes(), path_gaps_, known_cells_));
+    if (continuation_.active()) js["resumed"] = continuation_.report().json();
     return js;
   }
 
@@ -273,7 +289,7 @@ class SdpEngine final : public SlamEngine {
       return false;
     }
     *scans = scans_.size() + unrecorded_;
-    rebase_pending_ = true;
+    continuation_.begin(last_odom_, scans_.empty() ? 0 : scans_.back().stamp_us);
     return true;
   }
 
@@ -288,9 +304,9 @@ class SdpEngine final : public SlamEngine {
   std::uint64_t unrecorded_ = 0U;
   Pose2 last_odom_{};     // the last scan's odometry, in the session's odometry frame
   Pose2 last_pose_{};     // the last scan's estimate (spread())
-  Pose2 odom_offset_{};   // session frame ⊕ this = the encoders' frame since a resume
-  bool rebase_pending_ = false;
-  bool rebased_ = false;
+  slam::SessionContinuation continuation_;  // active after a resume
+  std::unique_ptr<RangeScan> carried_ = std::make_unique<RangeScan>();
+  std::string notice_;
   mutable std::uint64_t path_gaps_ = 0U;
   mutable std::uint32_t known_cells_ = 0U;
 };

@@ -48,6 +48,45 @@ TEST(SdpEngineNoHeap, process_does_not_allocate_across_segmentations) {
   LONGS_EQUAL(120, static_cast<long>(engine->trajectory().size()));
 }
 
+// A resumed session: the first scan after the restart is checked against the saved map
+// (a start-up step that allocates); from then on process() allocates nothing, the
+// odometry and stamps still carried across the break.
+TEST(SdpEngineNoHeap, a_resumed_engine_allocates_nothing_once_its_place_is_checked) {
+  DaemonConfig c = sdpslam::test::small_sdp_config();
+  c.output_directory = sdpslam::test::make_temp_dir("sdp_engine_no_heap_resume");
+  c.snapshot_interval_us = 1000000;
+  std::string error;
+  static sdpslam::RangeScan scan;
+  auto feed = [](sdpslam::daemon::SlamEngine& e, int k, double odom_origin_x) {
+    const double x = 2.0 + 0.05 * k;
+    box_scan(x, 3.0, 1000000 + 100000LL * k, &scan);
+    return e.process(sdpslam::OdometrySample{scan.stamp_us, sdpslam::Pose2{x - odom_origin_x, 0.0, 0.0}}, scan);
+  };
+  {
+    auto first = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
+    for (int k = 0; k < 60; ++k) feed(*first, k, 2.0);
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), 0U, &bytes, &error), error.c_str());
+  }
+  auto engine = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(engine != nullptr, error.c_str());
+  std::uint64_t scans = 0U;
+  CHECK_TRUE_TEXT(engine->resume_snapshot(sdpslam::daemon::snapshot_path(c), 0U, &scans, &error), error.c_str());
+  LONGS_EQUAL(60, static_cast<long>(scans));
+  CHECK_TRUE(feed(*engine, 60, 4.95).placed);  // the encoders count from zero again
+  std::size_t allocations = 0U;
+  for (int k = 61; k < 120; ++k) {
+    sdpslam::test::AllocationScope scope;
+    const sdpslam::daemon::EngineStep step = feed(*engine, k, 4.95);
+    allocations += scope.allocations();
+    CHECK_TRUE(step.placed);
+  }
+  LONGS_EQUAL(0, allocations);
+  STRCMP_EQUAL("in place", engine->status_json()["resumed"]["place"].get<std::string>().c_str());
+  LONGS_EQUAL(120, static_cast<long>(engine->trajectory().size()));
+}
+
 TEST(SdpEngineNoHeap, the_input_recorder_allocates_nothing_while_not_recording) {
   sdpslam::daemon::InputRecorder recorder;
   static sdpslam::RangeScan scan;

@@ -35,12 +35,13 @@ DaemonConfig sdp_config(const std::string& dir) {
 double truth_x(int k) { return 2.0 + 0.05 * (k < 60 ? k : k - 1); }
 
 // Scans `from` .. `to` - 1; the odometry counts from zero again at scan `restart`, as the
-// encoders of a restarted daemon do.
-void feed(sdpslam::daemon::SlamEngine& e, int from, int to, int restart) {
+// encoders of a restarted daemon do. With clock_restarts, so do the stamps (a power loss:
+// the monotonic clock starts again).
+void feed(sdpslam::daemon::SlamEngine& e, int from, int to, int restart, bool clock_restarts = false) {
   static sdpslam::RangeScan scan;
   for (int k = from; k < to; ++k) {
     const double x = truth_x(k);
-    box_scan(x, 3.0, 1000000 + 100000LL * k, &scan);
+    box_scan(x, 3.0, 1000000 + 100000LL * (clock_restarts && k >= restart ? k - restart : k), &scan);
     const double odom_x = k >= restart ? x - truth_x(restart) : x - 2.0;
     const sdpslam::OdometrySample odom{scan.stamp_us, sdpslam::Pose2{odom_x, 0.0, 0.0}};
     e.process(odom, scan);
@@ -112,6 +113,47 @@ TEST(SdpEngineSnapshot, a_restarted_engine_continues_the_session_from_where_the_
   CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
   // And the robot went on: the last pose is metres from the one at the restart.
   CHECK(after.back().pose.x_m - after[60].pose.x_m > 2.0);
+}
+
+// After a power loss the monotonic clock starts again: the new scans are stamped before
+// the session's last. They are moved to follow it (the session's paths are in time
+// order), and the robot goes on as if the clock had run on.
+TEST(SdpEngineSnapshot, a_clock_that_started_again_does_not_break_the_session_s_time_order) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_clock");
+  const DaemonConfig c = sdp_config(dir);
+  std::string error;
+  {
+    auto first = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
+    feed(*first, 0, 60, 1000);
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
+                    error.c_str());
+  }
+  auto second = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
+  NullClock clock;
+  std::FILE* log_file = std::tmpfile();
+  sdpslam::daemon::EventLog log(clock, 0, log_file);
+  CHECK_TRUE(sdpslam::daemon::resume_from_snapshot(c, *second, log) == sdpslam::daemon::ResumeOutcome::kResumed);
+  std::fclose(log_file);
+  feed(*second, 60, 120, 60, true);
+  const std::vector<sdpslam::io::StampedPose> after = second->trajectory();
+  LONGS_EQUAL(120, static_cast<long>(after.size()));
+  for (std::size_t k = 1; k < after.size(); ++k) CHECK(after[k].stamp_us > after[k - 1].stamp_us);
+  // The first new scan one second after the session's last.
+  LONGS_EQUAL(after[59].stamp_us + 1000000, after[60].stamp_us);
+  const sdpslam::io::Json js = second->status_json();
+  STRCMP_EQUAL("in place", js["resumed"]["place"].get<std::string>().c_str());
+  auto whole = sdpslam::daemon::make_engine(c, &error);
+  feed(*whole, 0, 120, 1000);
+  const std::vector<sdpslam::io::StampedPose> uninterrupted = whole->trajectory();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    worst = std::fmax(worst, std::hypot(after[k].pose.x_m - uninterrupted[k].pose.x_m,
+                                        after[k].pose.y_m - uninterrupted[k].pose.y_m));
+  }
+  CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
 }
 
 // Another configuration's snapshot, or one damaged on the way (a flipped byte), is not

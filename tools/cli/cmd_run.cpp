@@ -1,7 +1,7 @@
 // `sdpslam run LOG [--mode sdp|dpslam] [--top-particles T] [--particles B]
 //               [--topology sdp|segslam] [--profile accurate|paper] [--config FILE.ini]
 //               [--seed S] [--memory-budget-mib M] [--snapshot FILE [--snapshot-every-s S]]
-//               [--resume FILE] --out DIR`
+//               [--resume FILE | --extend FILE [--extend-window-m M]] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
 // (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
@@ -18,6 +18,7 @@
 #include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/run_sdp.h"
 #include "sdpslam/io/snapshot_file.h"
+#include "sdpslam/slam/session_continuation.h"
 
 namespace sdpslam::cli {
 namespace {
@@ -40,6 +41,8 @@ struct RunArgs {
   std::string snapshot;
   double snapshot_every_s = 0.0;
   std::string resume;
+  std::string extend;
+  double extend_window_m = slam::SessionContinuation::kDefaultWindowM;
   BagTopics bag;
 };
 
@@ -165,7 +168,9 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   ro.snapshot_path = a.snapshot;
   ro.snapshot_every_s = a.snapshot_every_s;
   ro.resume_path = a.resume;
-  if (!a.snapshot.empty() || !a.resume.empty()) {
+  ro.extend_path = a.extend;
+  ro.extend_window_m = a.extend_window_m;
+  if (!a.snapshot.empty() || !a.resume.empty() || !a.extend.empty()) {
     ro.config_fingerprint = config_fingerprint(a, profile, &error);
     if (!error.empty()) return report("", kExitBadInput, error);
   }
@@ -185,6 +190,10 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
       if (s.resumed_at_scan > 0U) {
         std::printf("sdpslam run: resumed from %s after scan %llu\n", a.resume.c_str(),
                     static_cast<unsigned long long>(s.resumed_at_scan));
+      }
+      if (s.extended_after_scan > 0U) {
+        std::printf("sdpslam run: extended the session of %s (%llu scans) with this log; %s\n", a.extend.c_str(),
+                    static_cast<unsigned long long>(s.extended_after_scan), s.extend_place.c_str());
       }
       if (s.snapshots_written > 0U) {
         std::printf("sdpslam run: %llu snapshots written to %s (%.1f MiB, at most %.0f ms each)\n",
@@ -268,12 +277,23 @@ std::function<int()> setup_run(CLI::App& app) {
   app.add_option("--resume", args->resume,
                  "sdp: continue the run a --snapshot file holds, on the same log with the same options (the scans "
                  "it holds are not processed again; the outputs are those of an uninterrupted run)");
+  app.add_option("--extend", args->extend,
+                 "sdp: continue the session a --snapshot file holds with this log, another recording of the same "
+                 "building (same options); the robot starts where the session left it, or where its first scan is "
+                 "found in the saved map within --extend-window-m; the outputs hold both runs");
+  app.add_option("--extend-window-m", args->extend_window_m,
+                 "with --extend: +- metres around where the session left the robot in which its first scan is looked "
+                 "for, at every heading (0 = take it to stand where it was left)")
+      ->check(CLI::Range(0.0, 50.0));
   add_bag_options(app, &args->bag);
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";
-    if (!sdp && (!args->snapshot.empty() || !args->resume.empty())) {
-      return report("", kExitUsage, "--snapshot and --resume apply to --mode sdp");
+    if (!sdp && (!args->snapshot.empty() || !args->resume.empty() || !args->extend.empty())) {
+      return report("", kExitUsage, "--snapshot, --resume and --extend apply to --mode sdp");
+    }
+    if (!args->resume.empty() && !args->extend.empty()) {
+      return report("", kExitUsage, "--resume continues the snapshot's own log, --extend another: give one");
     }
     if (args->snapshot.empty() && args->snapshot_every_s > 0.0) {
       return report("", kExitUsage, "--snapshot-every-s needs --snapshot");

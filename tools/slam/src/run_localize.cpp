@@ -42,6 +42,11 @@ std::vector<std::uint8_t> map_cells(const io::OccupancyImage& img, const io::Map
 bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error) {
   io::MapWriteOptions thresholds;
   if (!io::read_map_yaml(map_yaml, &out->image, &thresholds, error)) return false;
+  localization_map_from_image(thresholds, out);
+  return true;
+}
+
+void localization_map_from_image(const io::MapWriteOptions& thresholds, LocalizationMap* out) {
   out->cells = map_cells(out->image, thresholds);
   out->map = LocalizerMap{};
   out->map.width = out->image.width;
@@ -50,7 +55,6 @@ bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, st
   out->map.origin_x_m = out->image.origin_x_m;
   out->map.origin_y_m = out->image.origin_y_m;
   out->map.cells = out->cells.data();
-  return true;
 }
 
 bool parse_start_pose(const std::string& text, Pose2* pose) {

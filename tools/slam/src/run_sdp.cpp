@@ -19,6 +19,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/io/snapshot_file.h"
+#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/slam/slam_outputs.h"
@@ -309,9 +310,8 @@ bool write_snapshot(const SdpRunOptions& options, const std::vector<ScanRecord>&
   return true;
 }
 
-bool read_snapshot(const SdpRunOptions& options, RunnerState* st, SdpPermanentPath* permanent, SdpSlam& slam,
-                   std::string* error) {
-  const std::string& path = options.resume_path;
+bool read_snapshot(const SdpRunOptions& options, const std::string& path, RunnerState* st,
+                   SdpPermanentPath* permanent, SdpSlam& slam, std::string* error) {
   io::SnapshotInfo info;
   if (!io::check_snapshot(path, options.config_fingerprint, &info, error)) return false;
   io::SnapshotIn in;
@@ -372,11 +372,19 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   slam->set_listener(&rows);
 
   RunnerState resumed;
-  if (!options.resume_path.empty()) {
-    if (!read_snapshot(options, &resumed, &permanent, *slam, error)) return SdpRunStatus::kBadInput;
+  if (!options.resume_path.empty() && !options.extend_path.empty()) {
+    *error = "a run resumes its own log or extends a session with another, not both";
+    return SdpRunStatus::kBadInput;
+  }
+  const std::string& saved_path = options.resume_path.empty() ? options.extend_path : options.resume_path;
+  if (!saved_path.empty()) {
+    if (!read_snapshot(options, saved_path, &resumed, &permanent, *slam, error)) return SdpRunStatus::kBadInput;
     rows.rows = resumed.rows;
   }
-  const std::size_t resume_at = resumed.scans.size();
+  SessionContinuation continuation(options.extend_window_m);
+  const std::size_t extended_after = options.extend_path.empty() ? 0U : resumed.scans.size();
+  if (extended_after > 0U) continuation.begin(resumed.scans.back().odom, resumed.scans.back().stamp_us);
+  const std::size_t resume_at = options.extend_path.empty() ? resumed.scans.size() : 0U;
   std::vector<ScanRecord> scans = std::move(resumed.scans);
   std::uint64_t snapshots = 0U;
   std::uint64_t snapshot_bytes = 0U;
@@ -405,6 +413,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   detail::ScanOdometryPairing pairing;
   OdometrySample od;
   std::size_t index = 0U;  // of the scan (with odometry) in the log
+  auto scan_buffer = std::make_unique<RangeScan>();  // the scan as fed (stamp shifted by an extension)
+  RangeScan& scan = *scan_buffer;
   while (pairing.next(reader, &od)) {
     const io::LaserRecord& rec = reader.laser();
     if (index < resume_at) {
@@ -422,7 +432,14 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     ++index;
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
-    const SdpStepResult r = slam->process(od, rec.scan);
+    scan = rec.scan;
+    OdometrySample odom = od;
+    if (!continuation.carry(&odom, &scan, *slam)) {
+      // Held back while an extension looks for the robot in the saved map.
+      if (options.progress) options.progress(reader.input_offset());
+      continue;
+    }
+    const SdpStepResult r = slam->process(odom, scan);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     scan_ms.push_back(ms);
     const double cpu = thread_cpu_ms() - c0;
@@ -435,15 +452,15 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     split = std::max(split, cpu);
     if (cpu > 100.0) ++scans_cpu_over_100ms;
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
-    scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
+    scans.push_back(ScanRecord{scan.stamp_us, odom.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
     if (options.progress) options.progress(reader.input_offset());
     if (!options.snapshot_path.empty() && options.snapshot_every_s > 0.0) {
       if (!snapshot_clock_set) {
         snapshot_clock_set = true;
-        last_snapshot_us = rec.stamp_us;
-      } else if (static_cast<double>(rec.stamp_us - last_snapshot_us) * 1e-6 >= options.snapshot_every_s) {
+        last_snapshot_us = scan.stamp_us;
+      } else if (static_cast<double>(scan.stamp_us - last_snapshot_us) * 1e-6 >= options.snapshot_every_s) {
         if (!snapshot()) return SdpRunStatus::kIoError;
-        last_snapshot_us = rec.stamp_us;
+        last_snapshot_us = scan.stamp_us;
       }
     }
   }
@@ -509,6 +526,10 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
   js.update(sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells));
   js["resumed_at_scan"] = resume_at;
+  if (extended_after > 0U) {
+    js["extended"] = continuation.report().json();
+    js["extended"]["after_scan"] = extended_after;
+  }
   if (!options.snapshot_path.empty()) {
     js["snapshots"] = {{"written", snapshots},
                        {"file_bytes", snapshot_bytes},
@@ -516,6 +537,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
                        {"write_ms_max", ms(snapshot_ms_max)}};
   }
   js["timing"] = {{"wall_time_s", ms(wall_s)},
+                  {"extend_search_ms", ms(continuation.report().search_ms)},
                   {"scan_ms_p50", ms(percentile(scan_ms, 0.5))},
                   {"scan_ms_p99", ms(percentile(scan_ms, 0.99))},
                   {"scan_ms_max", ms(percentile(scan_ms, 1.0))},
@@ -542,6 +564,8 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     summary->icp_error_std_m = st.error_std_m();
     summary->icp_error_samples = st.error_samples;
     summary->resumed_at_scan = resume_at;
+    summary->extended_after_scan = extended_after;
+    if (extended_after > 0U) summary->extend_place = continuation.report().describe();
     summary->snapshots_written = snapshots;
     summary->snapshot_bytes = snapshot_bytes;
     summary->snapshot_write_ms_max = snapshot_ms_max;

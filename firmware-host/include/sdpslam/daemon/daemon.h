@@ -65,6 +65,7 @@ struct DaemonCounters {
   std::uint64_t scans_received = 0U;
   std::uint64_t scans_placed = 0U;           // given an odometry pose and fed to the engine
   std::uint64_t scans_processed = 0U;        // of those, the engine updated its particles
+  std::uint64_t scans_held = 0U;             // fed but not placed: a resumed session looking for the robot
   std::uint64_t scans_skipped_no_odometry = 0U;  // odometry did not catch up in time
   std::uint64_t scans_skipped_too_old = 0U;  // older than the odometry ring
   std::uint64_t scans_skipped_gap = 0U;      // across a stale-encoder break or a long gap

@@ -41,6 +41,8 @@ struct PoseSpread {
 struct EngineStep {
   bool processed = false;  // false: skipped by the filter (too little motion)
   Pose2 pose;              // best estimate at the scan, map frame
+  bool placed = true;      // false: held back, no estimate (sdp, after a resume: the robot
+                           // is being looked for in the saved map; pose is meaningless)
 };
 
 class SlamEngine {
@@ -63,6 +65,9 @@ class SlamEngine {
   // before the last trajectory()/map_image(); the periodic outputs never call it, so
   // they do not change what later scans do.
   virtual void finish() {}
+  // A line for the journal once, when something happened that a person should know
+  // (sdp: where a resumed session found the robot); empty otherwise.
+  virtual std::string take_notice() { return std::string(); }
 
   // ---- snapshots (io/snapshot_file.h) -----------------------------------------------
   // The engine's whole state (the SLAM state and its records of the scans), so that a

@@ -64,6 +64,9 @@ struct LocalizationMap {
 };
 // False, with "file[:line]: why", when the map cannot be read.
 bool load_localization_map(const std::string& map_yaml, LocalizationMap* out, std::string* error);
+// The same for a map already in out->image (e.g. a session's rendered global map), its
+// cells classed by these thresholds (map.yaml's).
+void localization_map_from_image(const io::MapWriteOptions& thresholds, LocalizationMap* out);
 
 // "x,y,theta" (m, m, rad; spaces allowed around the commas) to a pose; false on anything
 // else, a non-finite number included.

@@ -58,6 +58,15 @@ struct SdpRunOptions {
   std::string snapshot_path;
   double snapshot_every_s = 0.0;
   std::string resume_path;
+  // With extend_path set (not with resume_path), the run continues the session that
+  // snapshot holds with this log, another recording of the same building: every scan
+  // of the log is processed after the snapshot's, the robot taken to start where the
+  // session left it, or where its first scan is found in the saved map within
+  // ±extend_window_m (session_continuation.h; 0 = where it was left). The outputs hold
+  // both: the session's scans, then this log's (stamps shifted to follow the session's
+  // when they do not).
+  std::string extend_path;
+  double extend_window_m = 10.0;
   std::uint64_t config_fingerprint = 0U;
 };
 
@@ -67,6 +76,8 @@ struct SdpRunSummary : RunSummary {
   double icp_error_std_m = 0.0;
   std::uint64_t icp_error_samples = 0U;
   std::uint64_t resumed_at_scan = 0U;  // scans the resumed snapshot held (0: from the start)
+  std::uint64_t extended_after_scan = 0U;  // scans the extended session held (0: not extended)
+  std::string extend_place;            // what the extension found (ContinuationReport::describe)
   std::uint64_t snapshots_written = 0U;
   std::uint64_t snapshot_bytes = 0U;   // the last one's file size
   double snapshot_write_ms_max = 0.0;
