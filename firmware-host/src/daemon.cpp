@@ -151,7 +151,7 @@ void Daemon::place_scans(std::int64_t now_us, bool final_pass) {
     }
     const EngineStep s = io_.engine->process(slam_odom, slam_scan_);
     if (const std::string notice = io_.engine->take_notice(); !notice.empty()) {
-      log_.log(Event::kStartup, "%s", notice.c_str());
+      log_.log(Event::kSession, "%s", notice.c_str());
     }
     if (s.placed) ++counters_.scans_placed;
     else ++counters_.scans_held;

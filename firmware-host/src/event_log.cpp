@@ -5,6 +5,7 @@ namespace sdpslam::daemon {
 const char* to_string(Event e) {
   switch (e) {
     case Event::kStartup: return "startup";
+    case Event::kSession: return "session";
     case Event::kLaser: return "laser";
     case Event::kLaserData: return "laser-data";
     case Event::kCan: return "can";

@@ -167,6 +167,7 @@ class SdpEngine final : public SlamEngine {
     permanent_.reserve(c.max_trajectory_scans, c.max_trajectory_scans / c.sdp.min_segment_scans + 1U);
     slam_->set_permanent_sink(&permanent_);
     scans_.reserve(c.max_trajectory_scans);
+    output_directory_ = c.output_directory;
     return true;
   }
 
@@ -289,7 +290,15 @@ class SdpEngine final : public SlamEngine {
       return false;
     }
     *scans = scans_.size() + unrecorded_;
-    continuation_.begin(last_odom_, scans_.empty() ? 0 : scans_.back().stamp_us);
+    // The trajectory written every [output] period_s holds where the robot went after
+    // the snapshot (minutes apart): its last pose, if later, is where to look first.
+    const std::int64_t last_stamp_us = scans_.empty() ? 0 : scans_.back().stamp_us;
+    std::vector<io::StampedPose> written;
+    std::string ignored;
+    const bool later = !output_directory_.empty() &&
+                       io::read_trajectory(output_directory_ + "/trajectory.txt", &written, &ignored) &&
+                       !written.empty() && written.back().stamp_us > last_stamp_us;
+    continuation_.begin(last_odom_, last_stamp_us, later ? &written.back().pose : nullptr);
     return true;
   }
 
@@ -304,7 +313,8 @@ class SdpEngine final : public SlamEngine {
   std::uint64_t unrecorded_ = 0U;
   Pose2 last_odom_{};     // the last scan's odometry, in the session's odometry frame
   Pose2 last_pose_{};     // the last scan's estimate (spread())
-  slam::SessionContinuation continuation_;  // active after a resume
+  slam::SessionContinuation continuation_{slam::SessionContinuation::kDefaultWindowM, true};  // after a resume
+  std::string output_directory_;
   std::unique_ptr<RangeScan> carried_ = std::make_unique<RangeScan>();
   std::string notice_;
   mutable std::uint64_t path_gaps_ = 0U;

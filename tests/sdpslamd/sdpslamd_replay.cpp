@@ -6,8 +6,14 @@
 //
 //   sdpslamd_replay --log LOG --link PATH [--lines N] [--speed S] [--delay-s D]
 //       [--can-iface IF --candump FILE]                      frames on SocketCAN
-//       [--daemon SDPSLAMD --config INI --out DIR --candump FILE [--tail-s T]]
-//                                                           host: runs sdpslamd, SIGTERM at the end
+//       [--daemon SDPSLAMD --config INI --out DIR --candump FILE [--tail-s T]
+//        [--kill-at-s T1,T2,... [--down-s D]]]                host: runs sdpslamd, SIGTERM at the end
+// With --kill-at-s, a supervisor process runs sdpslamd and kills it with SIGKILL at each
+// of those times (seconds after the replay's start instant), starting it again D seconds
+// later (default 0.5) with the same arguments, as a power cut and a restart would; the
+// laser and the encoder frames go on meanwhile (the restarted sdpslamd's --can-candump
+// replay keeps the first start instant). SIGTERM at the end goes to the sdpslamd of the
+// moment.
 // Prints the emulator's counters and the timeline (to map sdpslamd's monotonic stamps back
 // to log time); exit 0 iff every CAN frame was sent and (host mode) sdpslamd exited 0.
 #include <signal.h>
@@ -26,9 +32,64 @@
 #include "sdpslam/replay/player.h"
 #include "sdpslam/replay/replay_log.h"
 
+namespace {
+
+volatile sig_atomic_t g_stop = 0;
+void on_term(int) { g_stop = 1; }
+
+int exit_code(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status); }
+
+// Runs `argv` (sdpslamd), killing it at kill_at_us (monotonic) and starting it again
+// down_us later; on SIGTERM, stops the running one with SIGTERM and exits with its status.
+[[noreturn]] void supervise(const std::vector<std::string>& args, const std::vector<std::int64_t>& kill_at_us,
+                            std::int64_t down_us, const sdpslam::hal::MonotonicClock& clock) {
+  struct sigaction sa {};
+  sa.sa_handler = on_term;
+  sigaction(SIGTERM, &sa, nullptr);
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  auto spawn = [&argv]() {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      execv(argv[0], argv.data());
+      std::perror("exec sdpslamd");
+      _exit(127);
+    }
+    return pid;
+  };
+  pid_t d = spawn();
+  std::size_t next = 0;
+  for (;;) {
+    int status = 0;
+    if (g_stop != 0) {
+      kill(d, SIGTERM);
+      waitpid(d, &status, 0);
+      std::fprintf(stderr, "supervisor: %zu kills\n", next);
+      _exit(exit_code(status));
+    }
+    if (waitpid(d, &status, WNOHANG) == d) {
+      std::fprintf(stderr, "supervisor: sdpslamd ended by itself (exit %d)\n", exit_code(status));
+      _exit(exit_code(status) == 0 ? 1 : exit_code(status));
+    }
+    if (next < kill_at_us.size() && clock.now_us() >= kill_at_us[next]) {
+      kill(d, SIGKILL);
+      waitpid(d, &status, 0);
+      ++next;
+      std::fprintf(stderr, "supervisor: killed sdpslamd with SIGKILL (%zu)\n", next);
+      usleep(static_cast<useconds_t>(down_us));
+      d = spawn();
+    }
+    usleep(10000);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace sdpslam;
-  std::string log_path, link, can_iface, candump, daemon, config, out;
+  std::string log_path, link, can_iface, candump, daemon, config, out, kill_at;
+  double down_s = 0.5;
   std::size_t lines = 0;
   double speed = 1.0, delay_s = 2.0, tail_s = 1.0;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -45,6 +106,8 @@ int main(int argc, char** argv) {
     else if (a == "--daemon") daemon = v;
     else if (a == "--config") config = v;
     else if (a == "--out") out = v;
+    else if (a == "--kill-at-s") kill_at = v;
+    else if (a == "--down-s") down_s = std::atof(v);
     else {
       std::fprintf(stderr, "sdpslamd_replay: unknown argument %s\n", a.c_str());
       return 2;
@@ -104,13 +167,19 @@ int main(int argc, char** argv) {
     const std::string start = std::to_string(start_us);
     char speed_text[32];
     std::snprintf(speed_text, sizeof speed_text, "%g", speed);
+    const std::vector<std::string> args = {daemon, "--config", config, "--out", out, "--can-candump", candump,
+                                           "--can-candump-start-us", start, "--can-candump-speed", speed_text};
+    std::vector<std::int64_t> kill_at_us;
+    for (const char* p = kill_at.c_str(); *p != '\0';) {
+      char* end = nullptr;
+      const double t = std::strtod(p, &end);
+      if (end == p) break;
+      kill_at_us.push_back(start_us + static_cast<std::int64_t>(t * 1e6));
+      p = *end == ',' ? end + 1 : end;
+    }
     child = fork();
     if (child == 0) {
-      execl(daemon.c_str(), daemon.c_str(), "--config", config.c_str(), "--out", out.c_str(), "--can-candump",
-            candump.c_str(), "--can-candump-start-us", start.c_str(), "--can-candump-speed", speed_text,
-            static_cast<char*>(nullptr));
-      std::perror("exec sdpslamd");
-      _exit(127);
+      supervise(args, kill_at_us, static_cast<std::int64_t>(down_s * 1e6), clock);
     }
   }
   replay::PlayerOptions po;

@@ -156,6 +156,48 @@ TEST(SdpEngineSnapshot, a_clock_that_started_again_does_not_break_the_session_s_
   CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
 }
 
+// Pushed 0.6 m on while sdpslamd was off: the first scan after the restart fits the saved
+// map there, unambiguously (the box's far wall pins the distance), so the session goes on
+// from there rather than from where it stopped; odometry alone could not know.
+TEST(SdpEngineSnapshot, a_robot_pushed_while_off_goes_on_where_its_first_scan_fits) {
+  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_pushed");
+  const DaemonConfig c = sdp_config(dir);
+  std::string error;
+  {
+    auto first = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
+    feed(*first, 0, 60, 1000);
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
+                    error.c_str());
+  }
+  auto second = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
+  std::uint64_t scans = 0U;
+  CHECK_TRUE_TEXT(second->resume_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &scans, &error),
+                  error.c_str());
+  static sdpslam::RangeScan scan;
+  const double pushed_x = truth_x(59) + 0.6;
+  for (int j = 0; j < 40; ++j) {
+    const double x = pushed_x + 0.05 * j;
+    box_scan(x, 3.0, 1000000 + 100000LL * (60 + j), &scan);
+    CHECK_TRUE(second->process(sdpslam::OdometrySample{scan.stamp_us, sdpslam::Pose2{0.05 * j, 0.0, 0.0}}, scan).placed);
+  }
+  const sdpslam::io::Json js = second->status_json();
+  STRCMP_EQUAL("in place", js["resumed"]["place"].get<std::string>().c_str());
+  DOUBLES_EQUAL(0.6, js["resumed"]["moved_m"].get<double>(), 0.1);
+  // The map frame is the first scan's pose (x = 2): every pose after the push within a
+  // decimetre of the truth.
+  const std::vector<sdpslam::io::StampedPose> after = second->trajectory();
+  LONGS_EQUAL(100, static_cast<long>(after.size()));
+  double worst = 0.0;
+  for (int j = 0; j < 40; ++j) {
+    const sdpslam::Pose2& p = after[static_cast<std::size_t>(60 + j)].pose;
+    worst = std::fmax(worst, std::hypot(p.x_m - (pushed_x + 0.05 * j - 2.0), p.y_m));
+  }
+  CHECK_TEXT(worst < 0.1, ("after the push the poses are up to " + std::to_string(worst) + " m off").c_str());
+}
+
 // Another configuration's snapshot, or one damaged on the way (a flipped byte), is not
 // read into the engine: it is moved aside, kept for inspection, and the caller starts a
 // new map. No snapshot at all: a fresh start.

@@ -131,9 +131,9 @@ std::string ContinuationReport::describe() const {
       return "the place was not checked against the saved map";
     case Place::kSearching:
       std::snprintf(text, sizeof text,
-                    "the first scan does not fit where the session left the robot (score %.2f, %.2f elsewhere): "
-                    "looking for it in the saved map, %llu scans so far",
-                    score_here, score_best, static_cast<unsigned long long>(scans_held));
+                    "the first scan does not fit where the robot was expected (score %.2f%s): looking for it in the "
+                    "saved map, its scans held back from mapping",
+                    score_here, score_here >= score_best ? "" : ", better elsewhere");
       return text;
     case Place::kInPlace:
       std::snprintf(text, sizeof text,
@@ -170,6 +170,7 @@ io::Json ContinuationReport::json() const {
     js["score_best"] = score_best;
     js["scans_held"] = scans_held;
     js["expected"] = {expected.x_m, expected.y_m, expected.heading_rad};
+    js["near"] = {near.x_m, near.y_m, near.heading_rad};
   }
   if (place == Place::kMoved || place == Place::kInPlace) {
     js["found"] = {found.x_m, found.y_m, found.heading_rad};
@@ -189,11 +190,15 @@ struct SessionContinuation::Search {
   std::uint32_t settled = 0U;  // updates in a row with the particles gathered
 };
 
-SessionContinuation::SessionContinuation(double window_m) : window_m_(window_m) {}
+SessionContinuation::SessionContinuation(double window_m, bool stayed_likely)
+    : window_m_(window_m), stayed_likely_(stayed_likely) {}
 SessionContinuation::~SessionContinuation() = default;
 
-void SessionContinuation::begin(const Pose2& last_odom, std::int64_t last_stamp_us) {
+void SessionContinuation::begin(const Pose2& last_odom, std::int64_t last_stamp_us, const Pose2* hint) {
+  has_hint_ = hint != nullptr;
+  if (hint != nullptr) hint_ = *hint;
   active_ = true;
+  first_input_ = true;
   rebased_ = false;
   last_odom_ = last_odom;
   last_stamp_us_ = last_stamp_us;
@@ -209,7 +214,8 @@ void SessionContinuation::rebase_at(const Pose2& odom_in) {
 bool SessionContinuation::carry(OdometrySample* odom, RangeScan* scan, SdpSlam& slam) {
   if (!active_) return true;
   using Place = ContinuationReport::Place;
-  if (report_.place == Place::kNotChecked && !rebased_ && report_.scans_held == 0U) {
+  if (first_input_) {
+    first_input_ = false;
     if (odom->stamp_us <= last_stamp_us_) report_.stamp_shift_us = last_stamp_us_ + 1000000 - odom->stamp_us;
   }
   odom->stamp_us += report_.stamp_shift_us;
@@ -285,24 +291,35 @@ void SessionContinuation::check_first(const RangeScan& scan, SdpSlam& slam) {
   const Pose2 expected = slam.current_frame().compose(slam.bottom().best_pose());
   report_.expected = expected;
   report_.found = expected;
+  const Pose2 near = has_hint_ ? hint_ : expected;
+  report_.near = near;
   io::OccupancyImage image;
   sdp_global_map_image(slam, &image);
   const SdpOptions& so = slam.options();
-  // Everywhere in the window, and where the session left the robot (±kNearM, ±kNearRad).
-  const CorrelativeResult best = match_scan(image, scan, expected, window_m_, det::kPi, so);
   const CorrelativeOptions co = scan_match_options(so, 0.0, 0.0);
-  const CorrelativeResult here = match_scan(image, scan, expected, kNearM, kNearRad, so);
-  report_.search_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (!matched(best)) return;  // too few points, or too many: kNoMap
-  report_.score_best = best.score;
+  // Near where the robot is expected (±kNearM, ±kNearRad) and, for another recording,
+  // everywhere in the window.
+  const CorrelativeResult here = match_scan(image, scan, near, kNearM, kNearRad, so);
+  if (here.status == CorrelativeResult::Status::kTooFewPoints) {
+    report_.search_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return;  // kNoMap
+  }
   report_.score_here = matched(here) ? here.score : 0.0;
-  // Not moved: the scan fits where the robot was left, and no place elsewhere in the
-  // window fits clearly better (by the matcher's ambiguity ratio, on the whole sums it
-  // ranks by). A robot is most likely where it was left: a scan that fits there and
-  // also elsewhere (a corridor) is no reason to look for it.
-  const double sum_best = best.score * static_cast<double>(best.overlap_points);
-  const double sum_here = matched(here) ? here.score * static_cast<double>(here.overlap_points) : 0.0;
-  if (!(report_.score_here >= co.min_score && sum_here >= co.max_ambiguity * sum_best)) {
+  bool look = report_.score_here < co.min_score;
+  if (!look && !stayed_likely_) {
+    // Not moved far: the scan fits near where the robot is expected and no place
+    // elsewhere in the window fits clearly better (by the matcher's ambiguity ratio, on
+    // the whole sums it ranks by). A scan that fits there and also elsewhere (a
+    // corridor) is no reason to look for the robot elsewhere.
+    const CorrelativeResult best = match_scan(image, scan, near, window_m_, det::kPi, so);
+    if (matched(best)) {
+      report_.score_best = best.score;
+      look = here.score * static_cast<double>(here.overlap_points) <
+             co.max_ambiguity * best.score * static_cast<double>(best.overlap_points);
+    }
+  }
+  report_.search_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (look) {
     report_.place = ContinuationReport::Place::kSearching;
     return;
   }

@@ -12,6 +12,7 @@ namespace sdpslam::daemon {
 
 enum class Event : std::uint8_t {
   kStartup,
+  kSession,        // where a resumed session found the robot
   kLaser,          // laser health changes, disconnects, restarts
   kLaserData,      // scans rejected by the laser driver (checksum, framing)
   kCan,            // CAN bus state changes, down / re-open

@@ -14,16 +14,18 @@
 //  - place: the robot may have been moved while nothing watched it.
 //     1. The first scan is matched against the saved map (the best combination's global
 //        map, rendered once) by exhaustive correlative search (core/loops/
-//        correlative_matcher.h), once within ±1 m and ±0.35 rad of where the session
-//        left the robot and once over ±window_m and every heading. If it fits where
-//        the robot was left (the matcher's min_score) and no place elsewhere fits
+//        correlative_matcher.h), once within ±1 m and ±0.35 rad of where the robot is
+//        expected (where the session left it, or a later pose given to begin()) and
+//        once over ±window_m and every heading. The robot was not moved far if the
+//        scan fits near where it is expected (the matcher's min_score) and, for input
+//        that is another recording (not stayed_likely), no place elsewhere fits
 //        clearly better (by the matcher's ambiguity ratio, on the whole sums it ranks
-//        by), the robot was not moved far: mapping goes on at once, from the pose the
-//        scan pins there when the matcher calls it distinct from where the robot was
-//        left (half a metre, a tenth of a radian; unambiguous), otherwise from where it
-//        was left, the bottom filter's scan matching taking up the rest as after any
-//        scan. A robot is most likely where it was left, so a view that fits there and
-//        elsewhere too (a corridor) is no reason to look for it.
+//        by). Mapping then goes on at once: from the pose the scan pins near there when
+//        the matcher calls it unambiguous and distinct from where the session left the
+//        robot (half a metre, a tenth of a radian), otherwise from where it was left,
+//        the bottom filter's scan matching taking up the rest as after any scan. A
+//        view that fits there and elsewhere too (a corridor) is no reason to look for
+//        the robot elsewhere.
 //     2. Otherwise the robot was moved. One scan cannot say where in a building of
 //        look-alike corridors, so the scans that follow go to global Monte Carlo
 //        localization on the saved map (core/localization, unknown start, as
@@ -37,9 +39,9 @@
 //        scan. After kMaxSearchScans without that, mapping goes on where the session
 //        left the robot (reported: the map may then show the area twice).
 //     The scans held back are not mapped and not in the trajectory (counted). Limits:
-//     a robot carried to a place that looks like where it was left is taken not to have
-//     moved, and one carried beyond ±window_m is looked for only if its first scan does
-//     not fit where it was left.
+//     one scan decides whether to look, so a robot carried to a place that looks like
+//     where it was left is taken not to have moved, and on a rough map a robot that did
+//     not move may be looked for (its scans held back until found or the limit).
 // Allocates while it checks and searches (the rendered map, the matcher's grids, the
 // localizer: the first scans after the break), never once mapping has gone on.
 #include <cstdint>
@@ -64,9 +66,10 @@ struct ContinuationReport {
   };
   Place place = Place::kNotChecked;
   Pose2 expected;                   // global pose where the session left the robot
+  Pose2 near;                       // where the first scan was looked for (expected, or a later hint)
   Pose2 found;                      // global pose where mapping went on (kMoved)
   double score_here = 0.0;          // the first scan's fit where the robot was left, [0, 1]
-  double score_best = 0.0;          // ... at the best place within the window
+  double score_best = 0.0;          // ... at the best place within the window (another recording only)
   std::uint64_t scans_held = 0U;    // scans given to the search, not mapped
   std::int64_t stamp_shift_us = 0;  // added to every new stamp
   double search_ms = 0.0;           // wall time of the checks (not in json(): not deterministic)
@@ -90,14 +93,23 @@ class SessionContinuation {
   static constexpr std::uint32_t kSettledUpdates = 5U;
   static constexpr std::uint64_t kMaxSearchScans = 600U;  // a minute of a 10 Hz laser
 
-  explicit SessionContinuation(double window_m = kDefaultWindowM);
+  // stayed_likely: the input follows a stop of the same robot (sdpslamd restarted: it
+  // most likely stands where it stopped), so a first scan that fits there is taken to
+  // be there even if a place elsewhere fits better (a rough map, a look-alike); the
+  // search starts only when it does not fit there. Otherwise (another recording) a
+  // place elsewhere that fits clearly better starts the search too.
+  explicit SessionContinuation(double window_m = kDefaultWindowM, bool stayed_likely = false);
   ~SessionContinuation();
   SessionContinuation(const SessionContinuation&) = delete;
   SessionContinuation& operator=(const SessionContinuation&) = delete;
 
   // After the session's state was loaded: its last odometry pose and scan stamp (the
   // session's frames). Until then (a fresh session) carry() passes input through.
-  void begin(const Pose2& last_odom, std::int64_t last_stamp_us);
+  // `hint` (may be null): a later global pose of the robot than the session's last, when
+  // one is known (sdpslamd's trajectory.txt, written every few seconds, against a
+  // snapshot written every few minutes: the robot drove on in between); the first scan
+  // is then looked for near it rather than near the session's last pose.
+  void begin(const Pose2& last_odom, std::int64_t last_stamp_us, const Pose2* hint = nullptr);
   bool active() const { return active_; }
 
   // Every odometry sample and scan of the new input, in order, before SdpSlam::process.
@@ -115,11 +127,15 @@ class SessionContinuation {
   void rebase_at(const Pose2& odom_in);
 
   double window_m_;
+  bool stayed_likely_;
   bool active_ = false;
+  bool first_input_ = false;
   bool rebased_ = false;
   Pose2 last_odom_{};
   std::int64_t last_stamp_us_ = 0;
   Pose2 odom_offset_{};  // session frame = this ⊕ the new input's odometry frame
+  bool has_hint_ = false;
+  Pose2 hint_{};
   ContinuationReport report_{};
   std::unique_ptr<Search> search_;
 };
