@@ -27,9 +27,6 @@ constexpr std::uint32_t kCoarseCells = 4U;
 // kMaxScanPoints.
 constexpr double kScanReachM = 20.0;
 constexpr std::uint32_t kMaxScanPoints = 360U;
-// Cells of the rendered map at or above this probability are walls (map.yaml's
-// occupied_thresh).
-constexpr double kOccupied = 0.65;
 // "Near" a pose: this window around it. Where the session left the robot, the first
 // scan is matched within it; a place found by global localization is taken when the
 // scan pins the pose within it (one unambiguous peak above the matcher's score, near the
@@ -37,6 +34,11 @@ constexpr double kOccupied = 0.65;
 // view that does not).
 constexpr double kNearM = 1.0;
 constexpr double kNearRad = 0.35;
+// Walls to match against: the rendered map's cells at or above this occupancy, the
+// confident ones (map_server's default occupied_thresh). The written map.yaml's lower
+// threshold also keeps cells that a grazing beam hit once, which make every place fit
+// a little.
+constexpr double kWallOccupancy = 0.65;
 // Fewest points either set must have for a match to mean anything.
 constexpr std::uint32_t kMinPoints = 20U;
 
@@ -87,7 +89,7 @@ CorrelativeResult match_scan(const io::OccupancyImage& image, const RangeScan& s
   std::vector<Point2> target;
   for (std::uint32_t row = 0; row < image.height; ++row) {
     for (std::uint32_t col = 0; col < image.width; ++col) {
-      if (!(image.occupancy[static_cast<std::size_t>(row) * image.width + col] >= kOccupied)) continue;
+      if (!(image.occupancy[static_cast<std::size_t>(row) * image.width + col] >= kWallOccupancy)) continue;
       const Point2 p{image.origin_x_m + (col + 0.5) * image.resolution_m,
                      image.origin_y_m + (row + 0.5) * image.resolution_m};
       if (std::fabs(p.x_m - guess.x_m) <= reach && std::fabs(p.y_m - guess.y_m) <= reach) target.push_back(p);
@@ -118,7 +120,6 @@ const char* ContinuationReport::place_name() const {
     case Place::kSearching: return "searching";
     case Place::kInPlace: return "in place";
     case Place::kMoved: return "moved";
-    case Place::kNotFound: return "not found";
     case Place::kNoMap: return "no map";
   }
   return "?";
@@ -132,8 +133,9 @@ std::string ContinuationReport::describe() const {
     case Place::kSearching:
       std::snprintf(text, sizeof text,
                     "the first scan does not fit where the robot was expected (score %.2f%s): looking for it in the "
-                    "saved map, its scans held back from mapping",
-                    score_here, score_here >= score_best ? "" : ", better elsewhere");
+                    "saved map; %llu scans held back from mapping so far",
+                    score_here, score_here >= score_best ? "" : ", better elsewhere",
+                    static_cast<unsigned long long>(scans_held));
       return text;
     case Place::kInPlace:
       std::snprintf(text, sizeof text,
@@ -148,13 +150,6 @@ std::string ContinuationReport::describe() const {
                     "(where mapping went on, after the robot's own motion); those scans are not mapped",
                     score_here, static_cast<unsigned long long>(scans_held), moved_m(),
                     turned_rad() * 57.29577951308232);
-      return text;
-    case Place::kNotFound:
-      std::snprintf(text, sizeof text,
-                    "the first scan did not fit where the session left the robot (score %.2f), and global "
-                    "localization in the saved map did not settle within %llu scans: continued where the robot was "
-                    "left; if it was moved, the map will show the area twice",
-                    score_here, static_cast<unsigned long long>(scans_held));
       return text;
     case Place::kNoMap:
       return "the saved map or the first scan holds too few points to match: continued where the session left the "
@@ -187,7 +182,7 @@ struct SessionContinuation::Search {
   std::unique_ptr<Arena> arena;
   MonteCarloLocalizer localizer;
   std::uint32_t updates = 0U;
-  std::uint32_t settled = 0U;  // updates in a row with the particles gathered
+  std::uint32_t settled = 0U;  // updates in a row with the particles gathered and the scan fitting there
 };
 
 SessionContinuation::SessionContinuation(double window_m, bool stayed_likely)
@@ -229,22 +224,23 @@ bool SessionContinuation::carry(OdometrySample* odom, RangeScan* scan, SdpSlam& 
     const MonteCarloLocalizer::Step st = search_->localizer.update(*odom, *scan);
     if (st.updated) {
       ++search_->updates;
-      search_->settled = st.spread_m < kConvergedSpreadM ? search_->settled + 1U : 0U;
+      // Gathered particles, and the scan of each update pinning the pose where they
+      // are: kSettledUpdates in a row, each after motion, so that one look-alike view
+      // cannot decide.
+      const bool settled = st.spread_m < kConvergedSpreadM && search_->updates >= kMinSearchUpdates;
+      search_->settled = settled && fits_at(*scan, st.pose, slam) ? search_->settled + 1U : 0U;
     }
-    if (st.updated && search_->updates >= kMinSearchUpdates && search_->settled >= kSettledUpdates &&
-        fits_at(*scan, st.pose, slam)) {
+    if (st.updated && search_->settled >= kSettledUpdates) {
       // Found: the session's last pose steps to this scan's place, and mapping goes on
       // from here with this scan's odometry taken as the session's last.
       report_.found = st.pose;
       const Pose2 delta = report_.expected.inverse().compose(st.pose);
-      report_.place = slam.relocate(delta) ? Place::kMoved : Place::kNotFound;
-      search_.reset();
-      rebase_at(odom->pose);
-    } else if (report_.scans_held >= kMaxSearchScans) {
-      report_.place = Place::kNotFound;
+      report_.place = slam.relocate(delta) ? Place::kMoved : Place::kNoMap;
       search_.reset();
       rebase_at(odom->pose);
     } else {
+      // Not found (yet): nothing is mapped at a guessed place, however long it takes;
+      // what the session holds stays as it is.
       ++report_.scans_held;
       return false;
     }
@@ -272,7 +268,7 @@ bool SessionContinuation::start_search(SdpSlam& slam) {
   search_ = std::make_unique<Search>();
   sdp_global_map_image(slam, &search_->map.image);
   if (search_->map.image.width == 0U) return false;
-  localization_map_from_image(io::MapWriteOptions{}, &search_->map);
+  localization_map_from_image(io::MapWriteOptions{}, &search_->map);  // kWallOccupancy, as map_server
   const LocalizerOptions options;
   const std::size_t bytes = MonteCarloLocalizer::required_arena_bytes(options, search_->map.map);
   if (bytes == 0U) return false;

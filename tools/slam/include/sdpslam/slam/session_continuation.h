@@ -29,15 +29,18 @@
 //     2. Otherwise the robot was moved. One scan cannot say where in a building of
 //        look-alike corridors, so the scans that follow go to global Monte Carlo
 //        localization on the saved map (core/localization, unknown start, as
-//        `sdpslam localize`) and are held back from mapping until the particles have
-//        stayed gathered within kConvergedSpreadM for kSettledUpdates updates, after at
-//        least kMinSearchUpdates (the robot must move for that), and the scan itself
-//        pins the pose there: an unambiguous correlative peak within ±1 m and ±0.35 rad of
-//        the estimate (a set gathered on a look-alike, or anywhere while the robot is
-//        where the map has nothing, tends to fail it). The session's particles are then
+//        `sdpslam localize`) and are held back from mapping until, for kSettledUpdates
+//        filter updates in a row after at least kMinSearchUpdates (the robot must move
+//        for that), the particles are gathered within kConvergedSpreadM and the update's
+//        scan itself pins the pose there: an unambiguous correlative peak within ±1 m
+//        and ±0.35 rad of the estimate (a set gathered on a look-alike, or anywhere
+//        while the robot is where the map has nothing, tends to fail it; several views
+//        in a row, taken as the robot moves, rarely all pass). The session's particles are then
 //        moved to the place found (SdpSlam::relocate) and mapping goes on from that
-//        scan. After kMaxSearchScans without that, mapping goes on where the session
-//        left the robot (reported: the map may then show the area twice).
+//        scan. Until then nothing is mapped, however long it takes: a robot placed at a
+//        guess would write the area twice into the saved map, which stays as it was
+//        (the report counts the scans held; a robot taken where the map has nothing is
+//        not mapped there).
 //     The scans held back are not mapped and not in the trajectory (counted). Limits:
 //     one scan decides whether to look, so a robot carried to a place that looks like
 //     where it was left is taken not to have moved, and on a rough map a robot that did
@@ -58,10 +61,9 @@ namespace sdpslam::slam {
 struct ContinuationReport {
   enum class Place : std::uint8_t {
     kNotChecked,  // no scan yet since the break, or the check is off (window 0)
-    kSearching,   // moved: global localization in progress, scans held back
+    kSearching,   // moved: global localization in progress (or it never found the robot), scans held back
     kInPlace,     // the first scan fits where the session left the robot
     kMoved,       // found elsewhere by global localization: the session was moved there
-    kNotFound,    // moved, but not found within kMaxSearchScans: continued where left
     kNoMap,       // the saved map or the first scan holds too few points: continued where left
   };
   Place place = Place::kNotChecked;
@@ -88,10 +90,9 @@ class SessionContinuation {
   // stamps are still carried across).
   static constexpr double kDefaultWindowM = 10.0;
   // Global localization's filter updates (one per 0.2 m or 0.2 rad of motion) before a
-  // place is taken, and those in a row with the particles gathered.
+  // place is taken, and those in a row with the particles gathered and the scan fitting.
   static constexpr std::uint32_t kMinSearchUpdates = 25U;
   static constexpr std::uint32_t kSettledUpdates = 5U;
-  static constexpr std::uint64_t kMaxSearchScans = 600U;  // a minute of a 10 Hz laser
 
   // stayed_likely: the input follows a stop of the same robot (sdpslamd restarted: it
   // most likely stands where it stopped), so a first scan that fits there is taken to
