@@ -6,8 +6,8 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/snapshot_file.h"
-#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/run_localize.h"
+#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::daemon {

@@ -19,9 +19,9 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/io/snapshot_file.h"
-#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
+#include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
 
