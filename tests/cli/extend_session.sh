@@ -18,57 +18,9 @@ rm -rf "$work" && mkdir -p "$work"
 "$sdpslam" simulate --world paper --seed 3 --quiet --out "$work/sim" >/dev/null || { echo "FAIL: simulate"; exit 1; }
 log=$work/sim/sim.clf
 
-# cut FIRST OUT [rebase]: the log's scans FIRST.. (1-based) with the odometry lines from
-# the one before FIRST; with rebase, the odometry re-zeroed at the first line kept and
-# the stamps restarted at 100 s. Without rebase: scans 1..900.
-cut() {
-  python3 - "$log" "$@" <<'PY'
-import math, sys
-log, first, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-rebase = len(sys.argv) > 4
-last = 900 if not rebase else 10 ** 9
-lines = [l.split() for l in open(log) if l.startswith(("ODOM", "ROBOTLASER1"))]
-kept, scan, start = [], 0, 0
-for i, f in enumerate(lines):
-    if f[0] == "ROBOTLASER1":
-        scan += 1
-        if scan == first:
-            start = len(kept)
-        if scan > last:
-            break
-    kept.append(f)
-# from the odometry line just before scan FIRST
-first_line = 0
-if first > 1:
-    n = 0
-    for j, f in enumerate(kept):
-        if f[0] == "ROBOTLASER1":
-            n += 1
-            if n == first - 1:
-                first_line = j + 1
-kept = kept[first_line:]
-T = None
-def tf(x, y, th):
-    c, s = math.cos(T[2]), math.sin(T[2])
-    dx, dy = x - T[0], y - T[1]
-    return c * dx + s * dy, -s * dx + c * dy, math.atan2(math.sin(th - T[2]), math.cos(th - T[2]))
-with open(out, "w") as o:
-    for f in kept:
-        f = f[:]
-        if rebase:
-            if T is None:
-                T = [float(v) for v in (f[1:4] if f[0] == "ODOM" else f[-11:-8])]
-                t0 = float(f[-3])
-            if f[0] == "ODOM":
-                f[1:4] = ["%.9f" % v for v in tf(*map(float, f[1:4]))]
-            else:
-                f[-14:-11] = ["%.9f" % v for v in tf(*map(float, f[-14:-11]))]  # laser pose
-                f[-11:-8] = ["%.9f" % v for v in tf(*map(float, f[-11:-8]))]   # robot pose
-            for k in (-3, -1):
-                f[k] = "%.6f" % (float(f[k]) - t0 + 100.0)
-        o.write(" ".join(f) + "\n")
-PY
-}
+# The log's scans FIRST..LAST, --rebase: as a recording of its own, odometry re-zeroed and
+# the clock restarted at 100 s (tools/bench/cut_log.py).
+cut() { python3 "$(dirname "$0")/../../tools/bench/cut_log.py" "$log" "$@"; }
 
 # check NAME FIRST_SCAN PLACE MAX_MEAN_M|MIN_MEAN_M: the extension's place and the error
 # of its first 200 placed scans (at most MAX, or with a leading '>' at least MIN).
@@ -109,7 +61,7 @@ elif not mean <= float(bound):
 PY
 }
 
-cut 1 "$work/a.clf" || { echo "FAIL: cut"; exit 1; }
+cut 1 900 "$work/a.clf" || { echo "FAIL: cut"; exit 1; }
 "$sdpslam" run "$work/a.clf" --seed 3 --quiet --snapshot "$work/a.sdps" --out "$work/session" >/dev/null ||
   { echo "FAIL: the session's run"; exit 1; }
 status=0
@@ -117,7 +69,7 @@ status=0
 extend() {
   name=$1 first=$2
   shift 2
-  cut "$first" "$work/$name.clf" rebase || return 1
+  cut "$first" 1000000000 "$work/$name.clf" --rebase || return 1
   "$sdpslam" run "$work/$name.clf" --seed 3 --quiet --extend "$work/a.sdps" "$@" --out "$work/$name" \
     >"$work/$name.log" 2>&1 || { echo "FAIL: extend $name:"; cat "$work/$name.log"; return 1; }
   grep "extended the session" "$work/$name.log"

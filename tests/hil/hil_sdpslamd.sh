@@ -25,22 +25,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work" && mkdir -p "$work/offline" "$work/out" "$work/recorded"
 head -n "$lines" "$log" >"$work/log.dat"
 "$make_candump" "$log" $((lines + 1)) "$work/ticks.candump" >/dev/null || exit 1
-cat >"$work/sdpslamd.ini" <<INI
-[can]
-interface = vcan0
-protocol = canopen
-left_node = 1
-right_node = 2
-sync_period_ms = 0
-position_timeout_ms = 500
-[laser]
-device = /tmp/laser
-protocol = scip
-stall_timeout_ms = 5000
-x_m = 0.145
-[sync]
-odometry_wait_ms = 400
-max_interpolation_gap_ms = 1500
+. "$here/../sdpslamd/tinyslam_ini.sh"
+{ tinyslam_sensors /tmp/laser vcan0 1500; cat <<INI; } >"$work/sdpslamd.ini"
 scan_queue = 16
 [slam]
 mode = dpslam

@@ -25,22 +25,10 @@ head -n "$lines" "$log" >"$work/log.dat"
 "$make_candump" "$log" $((lines + 1)) "$work/ticks.candump" >/dev/null || exit 1
 # The run lasts lines / 10 / speed seconds: kills at a quarter, half and three quarters.
 kills=$(awk -v n="$lines" -v s="$speed" 'BEGIN { d = n / 10 / s; printf "%.2f,%.2f,%.2f", d / 4, d / 2, 3 * d / 4 }')
+. "$(dirname "$0")/tinyslam_ini.sh"
 config() {
+  tinyslam_sensors "$work/laser"
   cat <<INI
-[can]
-protocol = canopen
-left_node = 1
-right_node = 2
-sync_period_ms = 0
-position_timeout_ms = 500
-[laser]
-device = $work/laser
-protocol = scip
-stall_timeout_ms = 5000
-x_m = 0.145
-[sync]
-odometry_wait_ms = 400
-max_interpolation_gap_ms = 500
 [slam]
 mode = sdp
 seed = 1
@@ -51,15 +39,7 @@ width_m = 40
 height_m = 40
 observations_base = 300000
 observations_per_particle = 20000
-[sdp]
-top_particles = 10
-period_scans = 4
-period_travel_m = 0
-min_segment_scans = 3
-max_segment_scans = 30
-max_levels = 3
-map_tile_capacity = 2000
-map_observation_capacity = 400000
+$(small_sdp_section)
 [output]
 directory = $1
 period_s = 1

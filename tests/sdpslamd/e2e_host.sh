@@ -29,19 +29,10 @@
 set -u
 daemon=$1 replay=$2 sdpslam=$3 make_candump=$4 log=$5 work=$6 lines=${7:-150} speed=${8:-1} fidelity=${9:-}
 mode=${10:-dpslam}
+. "$(dirname "$0")/tinyslam_ini.sh"
 case $mode in
   dpslam) sdp_section='' ;;
-  # Keys in this order: each [sdp] key is validated as it is read, and periodic
-  # segmentation needs some period at every step.
-  sdp) sdp_section='[sdp]
-top_particles = 10
-period_scans = 4
-period_travel_m = 0
-min_segment_scans = 3
-max_segment_scans = 30
-max_levels = 3
-map_tile_capacity = 2000
-map_observation_capacity = 400000' ;;
+  sdp) sdp_section=$(small_sdp_section) ;;
   *) echo "FAIL: unknown mode $mode"; exit 1 ;;
 esac
 [ -f "$log" ] || { echo "SKIP: $log is absent (shared data sets live beside the checkout)"; exit 77; }
@@ -50,21 +41,7 @@ head -n "$lines" "$log" >"$work/log.dat"
 # One tick sample more than scans: the last scan's stamp (arrival-based) is a little after
 # its own tick sample, and odometry must reach past it to place it.
 "$make_candump" "$log" $((lines + 1)) "$work/ticks.candump" >/dev/null || exit 1
-cat >"$work/sdpslamd.ini" <<INI
-[can]
-protocol = canopen
-left_node = 1
-right_node = 2
-sync_period_ms = 0
-position_timeout_ms = 500
-[laser]
-device = $work/laser
-protocol = scip
-stall_timeout_ms = 5000
-x_m = 0.145
-[sync]
-odometry_wait_ms = 400
-max_interpolation_gap_ms = 500
+{ tinyslam_sensors "$work/laser"; cat <<INI; } >"$work/sdpslamd.ini"
 [slam]
 mode = $mode
 seed = 1

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,36 @@ bool exists(const std::string& p) {
   return f != nullptr;
 }
 
+// A session of scans 0 .. 59 saved by one engine and resumed by a new one (a restart).
+std::unique_ptr<sdpslam::daemon::SlamEngine> resumed_session(const DaemonConfig& c) {
+  std::string error;
+  {
+    auto first = sdpslam::daemon::make_engine(c, &error);
+    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
+    feed(*first, 0, 60, 1000);
+    std::uint64_t bytes = 0U;
+    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
+                    error.c_str());
+  }
+  auto second = sdpslam::daemon::make_engine(c, &error);
+  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
+  std::uint64_t scans = 0U;
+  CHECK_TRUE_TEXT(second->resume_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &scans, &error),
+                  error.c_str());
+  LONGS_EQUAL(60, static_cast<long>(scans));
+  return second;
+}
+
+// The largest position difference between two trajectories of the same scans.
+double worst_difference(const std::vector<sdpslam::io::StampedPose>& a, const std::vector<sdpslam::io::StampedPose>& b) {
+  LONGS_EQUAL(a.size(), b.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    worst = std::fmax(worst, std::hypot(a[k].pose.x_m - b[k].pose.x_m, a[k].pose.y_m - b[k].pose.y_m));
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST_GROUP(SdpEngineSnapshot){};
@@ -103,13 +134,7 @@ TEST(SdpEngineSnapshot, a_restarted_engine_continues_the_session_from_where_the_
   // rounding.
   auto whole = sdpslam::daemon::make_engine(c, &error);
   feed(*whole, 0, 120, 1000);
-  const std::vector<sdpslam::io::StampedPose> uninterrupted = whole->trajectory();
-  LONGS_EQUAL(uninterrupted.size(), after.size());
-  double worst = 0.0;
-  for (std::size_t k = 0; k < after.size(); ++k) {
-    worst = std::fmax(worst, std::hypot(after[k].pose.x_m - uninterrupted[k].pose.x_m,
-                                        after[k].pose.y_m - uninterrupted[k].pose.y_m));
-  }
+  const double worst = worst_difference(after, whole->trajectory());
   CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
   // And the robot went on: the last pose is metres from the one at the restart.
   CHECK(after.back().pose.x_m - after[60].pose.x_m > 2.0);
@@ -119,24 +144,8 @@ TEST(SdpEngineSnapshot, a_restarted_engine_continues_the_session_from_where_the_
 // the session's last. They are moved to follow it (the session's paths are in time
 // order), and the robot goes on as if the clock had run on.
 TEST(SdpEngineSnapshot, a_clock_that_started_again_does_not_break_the_session_s_time_order) {
-  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_clock");
-  const DaemonConfig c = sdp_config(dir);
-  std::string error;
-  {
-    auto first = sdpslam::daemon::make_engine(c, &error);
-    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
-    feed(*first, 0, 60, 1000);
-    std::uint64_t bytes = 0U;
-    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
-                    error.c_str());
-  }
-  auto second = sdpslam::daemon::make_engine(c, &error);
-  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
-  NullClock clock;
-  std::FILE* log_file = std::tmpfile();
-  sdpslam::daemon::EventLog log(clock, 0, log_file);
-  CHECK_TRUE(sdpslam::daemon::resume_from_snapshot(c, *second, log) == sdpslam::daemon::ResumeOutcome::kResumed);
-  std::fclose(log_file);
+  const DaemonConfig c = sdp_config(sdpslam::test::make_temp_dir("sdp_engine_clock"));
+  auto second = resumed_session(c);
   feed(*second, 60, 120, 60, true);
   const std::vector<sdpslam::io::StampedPose> after = second->trajectory();
   LONGS_EQUAL(120, static_cast<long>(after.size()));
@@ -145,14 +154,10 @@ TEST(SdpEngineSnapshot, a_clock_that_started_again_does_not_break_the_session_s_
   LONGS_EQUAL(after[59].stamp_us + 1000000, after[60].stamp_us);
   const sdpslam::io::Json js = second->status_json();
   STRCMP_EQUAL("in place", js["resumed"]["place"].get<std::string>().c_str());
+  std::string error;
   auto whole = sdpslam::daemon::make_engine(c, &error);
   feed(*whole, 0, 120, 1000);
-  const std::vector<sdpslam::io::StampedPose> uninterrupted = whole->trajectory();
-  double worst = 0.0;
-  for (std::size_t k = 0; k < after.size(); ++k) {
-    worst = std::fmax(worst, std::hypot(after[k].pose.x_m - uninterrupted[k].pose.x_m,
-                                        after[k].pose.y_m - uninterrupted[k].pose.y_m));
-  }
+  const double worst = worst_difference(after, whole->trajectory());
   CHECK_TEXT(worst < 1e-6, ("resumed and uninterrupted differ by up to " + std::to_string(worst) + " m").c_str());
 }
 
@@ -160,22 +165,7 @@ TEST(SdpEngineSnapshot, a_clock_that_started_again_does_not_break_the_session_s_
 // map there, unambiguously (the box's far wall pins the distance), so the session goes on
 // from there rather than from where it stopped; odometry alone could not know.
 TEST(SdpEngineSnapshot, a_robot_pushed_while_off_goes_on_where_its_first_scan_fits) {
-  const std::string dir = sdpslam::test::make_temp_dir("sdp_engine_pushed");
-  const DaemonConfig c = sdp_config(dir);
-  std::string error;
-  {
-    auto first = sdpslam::daemon::make_engine(c, &error);
-    CHECK_TRUE_TEXT(first != nullptr, error.c_str());
-    feed(*first, 0, 60, 1000);
-    std::uint64_t bytes = 0U;
-    CHECK_TRUE_TEXT(first->save_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &bytes, &error),
-                    error.c_str());
-  }
-  auto second = sdpslam::daemon::make_engine(c, &error);
-  CHECK_TRUE_TEXT(second != nullptr, error.c_str());
-  std::uint64_t scans = 0U;
-  CHECK_TRUE_TEXT(second->resume_snapshot(sdpslam::daemon::snapshot_path(c), c.slam_fingerprint, &scans, &error),
-                  error.c_str());
+  auto second = resumed_session(sdp_config(sdpslam::test::make_temp_dir("sdp_engine_pushed")));
   static sdpslam::RangeScan scan;
   const double pushed_x = truth_x(59) + 0.6;
   for (int j = 0; j < 40; ++j) {

@@ -31,54 +31,8 @@ sdpslam=$build/tools/cli/sdpslam
 out=${EXTEND_OUT:-/tmp/sdpslam-extend}/$(basename "$log" .clf)
 rm -rf "$out" && mkdir -p "$out"
 
-# cut FIRST LAST OUT [rebase]: the log's laser scans FIRST..LAST (FLASER or ROBOTLASER1)
-# with the odometry lines from the one after scan FIRST - 1.
-cut() {
-  python3 - "$log" "$@" <<'PY'
-import math, sys
-log, first, last, out = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
-rebase = len(sys.argv) > 5
-kept, scan = [], 0
-for l in open(log):
-    f = l.split()
-    if not f or f[0] not in ("ODOM", "FLASER", "ROBOTLASER1"):
-        continue
-    if f[0] != "ODOM":
-        scan += 1
-        if scan > last:
-            break
-        if scan >= first:
-            kept.append(f)
-    elif scan >= first - 1:
-        kept.append(f)
-# Pose fields: ODOM x y theta; FLASER ... x y theta odom_x odom_y odom_theta ts host
-# logger_ts; ROBOTLASER1 ... laser x y theta, robot x y theta, 5 more, ts host logger_ts.
-def poses(f):
-    if f[0] == "ODOM":
-        return [1]
-    if f[0] == "FLASER":
-        return [len(f) - 9, len(f) - 6]
-    return [len(f) - 14, len(f) - 11]
-T = t0 = l0 = None
-def tf(x, y, th):
-    c, s = math.cos(T[2]), math.sin(T[2])
-    dx, dy = x - T[0], y - T[1]
-    return c * dx + s * dy, -s * dx + c * dy, math.atan2(math.sin(th - T[2]), math.cos(th - T[2]))
-with open(out, "w") as o:
-    for f in kept:
-        f = f[:]
-        if rebase:
-            if T is None:
-                i = poses(f)[-1]
-                T = [float(v) for v in f[i:i + 3]]
-                t0, l0 = float(f[-3]), float(f[-1])
-            for i in poses(f):
-                f[i:i + 3] = ["%.9f" % v for v in tf(*map(float, f[i:i + 3]))]
-            f[-3] = "%.6f" % (float(f[-3]) - t0 + 100.0)
-            f[-1] = "%.6f" % (float(f[-1]) - l0 + 100.0)
-        o.write(" ".join(f) + "\n")
-PY
-}
+# The log's scans FIRST..LAST, --rebase: as a recording of its own (cut_log.py).
+cut() { python3 "$(dirname "$0")/cut_log.py" "$log" "$@"; }
 
 cut 1 "$split" "$out/session.clf" || exit 1
 "$sdpslam" run "$out/session.clf" --seed "$seed" --quiet --snapshot "$out/session.sdps" --out "$out/session" \
@@ -88,7 +42,7 @@ cut 1 "$split" "$out/session.clf" || exit 1
 echo "| log | seed | session: scans | second recording from scan | place | scans held | found from where it stopped | search ms | extended: relations mean / max m | uninterrupted, same relations | relations |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for k in $starts; do
-  cut "$k" 1000000000 "$out/from$k.clf" rebase || exit 1
+  cut "$k" 1000000000 "$out/from$k.clf" --rebase || exit 1
   "$sdpslam" run "$out/from$k.clf" --seed "$seed" --quiet --extend "$out/session.sdps" --out "$out/from$k" \
     >"$out/from$k.log" 2>&1 || { echo "extension from scan $k failed" >&2; cat "$out/from$k.log" >&2; continue; }
   python3 - "$log" "$rel" "$out" "$k" "$split" <<'PY' > "$out/from$k.info" || continue
