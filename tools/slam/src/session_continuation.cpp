@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "sdpslam/core/arena.h"
@@ -216,8 +217,9 @@ bool SessionContinuation::carry(OdometrySample* odom, RangeScan* scan, SdpSlam& 
   odom->stamp_us += report_.stamp_shift_us;
   scan->stamp_us += report_.stamp_shift_us;
   if (report_.place == Place::kNotChecked && !rebased_) {
-    if (window_m_ > 0.0) check_first(*scan, slam);
-    if (report_.place == Place::kSearching && !start_search(slam)) report_.place = Place::kNoMap;
+    io::OccupancyImage image;
+    if (window_m_ > 0.0) check_first(*scan, slam, &image);
+    if (report_.place == Place::kSearching && !start_search(std::move(image))) report_.place = Place::kNoMap;
     if (report_.place != Place::kSearching) rebase_at(odom->pose);
   }
   if (report_.place == Place::kSearching) {
@@ -263,10 +265,10 @@ bool SessionContinuation::fits_at(const RangeScan& scan, const Pose2& pose, cons
   return !co.distinct(d.x_m, d.y_m, d.heading_rad);
 }
 
-bool SessionContinuation::start_search(SdpSlam& slam) {
+bool SessionContinuation::start_search(io::OccupancyImage&& image) {
   const auto t0 = std::chrono::steady_clock::now();
   search_ = std::make_unique<Search>();
-  sdp_global_map_image(slam, &search_->map.image);
+  search_->map.image = std::move(image);
   if (search_->map.image.width == 0U) return false;
   localization_map_from_image(io::MapWriteOptions{}, &search_->map);  // kWallOccupancy, as map_server
   const LocalizerOptions options;
@@ -281,7 +283,7 @@ bool SessionContinuation::start_search(SdpSlam& slam) {
   return true;
 }
 
-void SessionContinuation::check_first(const RangeScan& scan, SdpSlam& slam) {
+void SessionContinuation::check_first(const RangeScan& scan, SdpSlam& slam, io::OccupancyImage* image_out) {
   const auto t0 = std::chrono::steady_clock::now();
   report_.place = ContinuationReport::Place::kNoMap;
   const Pose2 expected = slam.current_frame().compose(slam.bottom().best_pose());
@@ -289,7 +291,7 @@ void SessionContinuation::check_first(const RangeScan& scan, SdpSlam& slam) {
   report_.found = expected;
   const Pose2 near = has_hint_ ? hint_ : expected;
   report_.near = near;
-  io::OccupancyImage image;
+  io::OccupancyImage& image = *image_out;
   sdp_global_map_image(slam, &image);
   const SdpOptions& so = slam.options();
   const CorrelativeOptions co = scan_match_options(so, 0.0, 0.0);

@@ -56,6 +56,10 @@
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/json_text.h"
 
+namespace sdpslam::io {
+struct OccupancyImage;
+}  // namespace sdpslam::io
+
 namespace sdpslam::slam {
 
 struct ContinuationReport {
@@ -122,8 +126,9 @@ class SessionContinuation {
 
  private:
   struct Search;
-  void check_first(const RangeScan& scan, SdpSlam& slam);
-  bool start_search(SdpSlam& slam);
+  // `image`: the saved map as rendered for the check, kept for the search.
+  void check_first(const RangeScan& scan, SdpSlam& slam, io::OccupancyImage* image);
+  bool start_search(io::OccupancyImage&& image);
   bool fits_at(const RangeScan& scan, const Pose2& pose, const SdpSlam& slam);
   void rebase_at(const Pose2& odom_in);
 
