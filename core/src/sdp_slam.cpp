@@ -32,6 +32,17 @@ LoopSearchGeometry search_geometry(const DpSlamOptions& b, const SdpOptions& s) 
 // The loop-closure graph holds every permanent submap still kept and every live level.
 std::uint32_t graph_nodes(const SdpOptions& s) { return s.max_permanent_submaps + s.max_levels; }
 
+// Obstacle points are kept for loop closure only.
+SubmapStoreOptions store_options(const SdpOptions& s, std::uint32_t n) {
+  SubmapStoreOptions o;
+  o.max_levels = s.max_levels;
+  o.nodes = n;
+  o.skeleton_points = s.skeleton_points;
+  o.obstacle_points = s.loop_closure ? s.loop_points : 0U;
+  o.max_permanent = s.max_permanent_submaps;
+  return o;
+}
+
 SegmentGraphOptions graph_options(const SdpOptions& s, std::uint32_t n) {
   SegmentGraphOptions g;
   g.max_levels = s.max_levels;
@@ -102,7 +113,6 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   const std::size_t gb = SegmentGraph::required_bytes(graph_options(s, b.particle_count));
   if (gb == 0U) return 0U;
   const std::size_t n = b.particle_count;
-  const std::size_t t = s.top_particles;
   const std::size_t L = s.max_levels;
   const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
   const std::size_t cs = coarse_side_cells(b, s);
@@ -110,16 +120,13 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   if (pb == 0U) return 0U;
   std::size_t total = fb + gb + pb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
   total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
-  total += Arena::bytes_for<Submap>(L * n) + Arena::bytes_for<Point2>(L * n * s.skeleton_points) + Arena::bytes_for<Level>(L);
-  total += Arena::bytes_for<Permanent>(s.max_permanent_submaps) + Arena::bytes_for<Point2>(s.max_permanent_submaps * std::size_t{s.skeleton_points});
-  total += 2U * Arena::bytes_for<std::uint16_t>(t * L) + Arena::bytes_for<double>(t) + Arena::bytes_for<std::uint8_t>(t) +
-           Arena::bytes_for<std::uint32_t>(t);
+  total += SubmapStore::required_bytes(store_options(s, b.particle_count));
+  total += TopParticles::required_bytes(TopParticleOptions::from(s));
   total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
-  total += Arena::bytes_for<StampedPose>(ring_capacity_for(s)) + Arena::bytes_for<IcpMemo>(kIcpMemoSlots) + Arena::bytes_for<NodeId>(n);
+  total += Arena::bytes_for<StampedPose>(ring_capacity_for(s)) + CombinationEvaluator::required_bytes() + Arena::bytes_for<NodeId>(n);
   if (s.loop_closure) {
     total += LoopClosure::required_bytes(s, graph_nodes(s), search_geometry(b, s));
-    total += Arena::bytes_for<CellPoint>((L * n + s.max_permanent_submaps) * std::size_t{s.loop_points}) +
-             2U * Arena::bytes_for<Point2>(s.loop_points);
+    total += 2U * Arena::bytes_for<Point2>(s.loop_points);
   }
   total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
   return total + kSlack;
@@ -178,7 +185,6 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   options_ = s;
   bottom_options_ = b;
   n_bottom_ = b.particle_count;
-  n_top_ = s.top_particles;
   // The bottom filter, ICP and segmenter live in the arena: placement new below (init
   // only) constructs them there; nothing comes from the heap (tests/sdp/test_sdp_no_heap).
   void* fmem = arena.allocate(sizeof(DpSlamFilter), alignof(DpSlamFilter));
@@ -219,29 +225,28 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     return false;
   }
   const std::uint32_t L = s.max_levels;
-  submaps_ = arena.allocate_array<Submap>(std::size_t{L} * n_bottom_);
-  live_points_ = arena.allocate_array<Point2>(std::size_t{L} * n_bottom_ * s.skeleton_points);
-  levels_ = arena.allocate_array<Level>(L);
-  perm_ = arena.allocate_array<Permanent>(s.max_permanent_submaps);
-  perm_points_ = arena.allocate_array<Point2>(std::size_t{s.max_permanent_submaps} * s.skeleton_points);
-  choices_ = arena.allocate_array<std::uint16_t>(std::size_t{n_top_} * L);
-  scratch_choices_ = arena.allocate_array<std::uint16_t>(std::size_t{n_top_} * L);
-  error_ = arena.allocate_array<double>(n_top_);
-  has_error_ = arena.allocate_array<std::uint8_t>(n_top_);
-  order_ = arena.allocate_array<std::uint32_t>(n_top_);
+  if (!store_.init(store_options(s, n_bottom_), arena)) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the submap store");
+    return false;
+  }
+  if (!top_.init(TopParticleOptions::from(s), arena)) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the top-level particles");
+    return false;
+  }
   chain_ = arena.allocate_array<std::uint32_t>(L);
   frames_ = arena.allocate_array<Pose2>(L);
   eval_frames_ = arena.allocate_array<Pose2>(L);
   poses_scratch_ = arena.allocate_array<Pose2>(n_bottom_);
   ring_capacity_ = ring_capacity_for(s);
   ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
-  memo_ = arena.allocate_array<IcpMemo>(kIcpMemoSlots);
+  if (!evaluator_.init(CombinationOptions::from(s), icp_, arena)) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the ICP memo");
+    return false;
+  }
   if (s.loop_closure) {
-    live_obst_ = arena.allocate_array<CellPoint>(std::size_t{L} * n_bottom_ * s.loop_points);
-    perm_obst_ = arena.allocate_array<CellPoint>(std::size_t{s.max_permanent_submaps} * s.loop_points);
     obst_a_ = arena.allocate_array<Point2>(s.loop_points);
     obst_b_ = arena.allocate_array<Point2>(s.loop_points);
-    if (live_obst_ == nullptr || perm_obst_ == nullptr || obst_a_ == nullptr || obst_b_ == nullptr ||
+    if (obst_a_ == nullptr || obst_b_ == nullptr ||
         !loop_closure_.init(s, graph_nodes(s), search_geometry(b, s), icp_, &loop_view_, &stats_, arena)) {
       std::snprintf(why_, sizeof why_, "arena exhausted (loop closure)");
       return false;
@@ -253,23 +258,12 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
   fine_known_ = arena.allocate_array<std::uint8_t>(fine_cells_);
   coarse_ = arena.allocate_array<CellState>(std::size_t{coarse_side_} * coarse_side_);
-  if (submaps_ == nullptr || live_points_ == nullptr || levels_ == nullptr || perm_ == nullptr ||
-      perm_points_ == nullptr || choices_ == nullptr || scratch_choices_ == nullptr || error_ == nullptr ||
-      has_error_ == nullptr || order_ == nullptr || chain_ == nullptr || frames_ == nullptr ||
+  if (chain_ == nullptr || frames_ == nullptr ||
       eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
-      fine_known_ == nullptr || coarse_ == nullptr || memo_ == nullptr || release_queue_ == nullptr) {
+      fine_known_ == nullptr || coarse_ == nullptr || release_queue_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
   }
-  for (std::size_t i = 0; i < std::size_t{L} * n_bottom_; ++i) submaps_[i] = Submap{};
-  for (std::uint32_t i = 0; i < L; ++i) levels_[i] = Level{};
-  for (std::uint32_t i = 0; i < kIcpMemoSlots; ++i) memo_[i] = IcpMemo{};
-  for (std::uint32_t p = 0; p < n_top_; ++p) {
-    error_[p] = 0.0;
-    has_error_[p] = 0U;
-    order_[p] = p;
-  }
-  for (std::size_t i = 0; i < std::size_t{n_top_} * L; ++i) choices_[i] = 0U;
   rng_.reseed(seed ^ 0x5D95E6A1C3B2F407ULL);
   stats_ = SdpStats{};
   arena_used_ = arena.used_bytes() - used0;
@@ -330,20 +324,7 @@ CellRect SdpSlam::rect_around(double x0, double y0, double x1, double y1, double
 }
 
 void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
-  double s = 0.0;
-  double q = 0.0;
-  std::uint32_t c = 0U;
-  for (std::uint32_t p = 0; p < n_top_; ++p) {
-    if (has_error_[p] == 0U) continue;
-    s += error_[p];
-    q += error_[p] * error_[p];
-    ++c;
-  }
-  const double m = c > 0U ? s / static_cast<double>(c) : 0.0;
-  const double v = c > 0U ? q / static_cast<double>(c) - m * m : 0.0;
-  if (mean_m != nullptr) *mean_m = m;
-  if (std_m != nullptr) *std_m = v > 0.0 ? det::sqrt(v) : 0.0;
-  if (count != nullptr) *count = c;
+  top_.error_summary(mean_m, std_m, count);
 }
 
 // ---- per scan -------------------------------------------------------------------------
@@ -412,19 +393,19 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
   result.work_cells = do_work(options_.work_cells_per_scan);
   bool work_pending = false;
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && !work_pending; ++lv) {
-    for (std::uint32_t k = 0; k < levels_[slot(lv)].count; ++k) {
-      if (!submap(lv, k).skeleton_done) {
+    for (std::uint32_t k = 0; k < store_.level(lv).count; ++k) {
+      if (!store_.submap(lv, k).skeleton_done) {
         work_pending = true;
         break;
       }
     }
   }
   if (round_active_ && !work_pending) {
-    for (std::uint32_t e = 0; e < options_.evaluations_per_scan && eval_cursor_ < n_top_; ++e) {
+    for (std::uint32_t e = 0; e < options_.evaluations_per_scan && eval_cursor_ < top_.size(); ++e) {
       evaluate(eval_cursor_++);
       ++result.evaluations;
     }
-    if (eval_cursor_ >= n_top_) end_round(scan.stamp_us, true);
+    if (eval_cursor_ >= top_.size()) end_round(scan.stamp_us, true);
   }
   if (options_.loop_closure && options_.loop_search_window_m > 0.0 && !work_pending && started_) loop_closure_.search_step();
   result.pose = current_frame_.compose(result.bottom.pose);
@@ -476,13 +457,13 @@ void SdpSlam::segment(std::int64_t stamp_us) {
     return;
   }
   const std::uint32_t level = added.level;
-  Level& lv = levels_[slot(level)];
+  SubmapLevel& lv = store_.level(level);
   lv.start_stamp_us = segment_start_stamp_us_;
   lv.end_stamp_us = stamp_us;
   lv.count = n;
   const double pad = bottom_options_.beam.max_update_range_m;
   for (std::uint32_t i = 0; i < n; ++i) {
-    Submap& sm = submap(level, i);
+    Submap& sm = store_.submap(level, i);
     sm = Submap{};
     sm.node = nodes[i];
     sm.initial = segment_start_pose_;
@@ -511,8 +492,8 @@ void SdpSlam::segment(std::int64_t stamp_us) {
 
   // Lines 10-11: resample with elitism, extend to the new level, start evaluating.
   if (round_active_) end_round(stamp_us, false);  // a round cut short keeps what it measured
-  if (level > graph_.first_live_level()) resample_and_diversify();
-  extend_to_level(level, bottom_best);
+  if (level > graph_.first_live_level()) top_.resample_and_diversify(graph_, rng_);
+  top_.extend_to_level(level, bottom_best, graph_, rng_);
   rounds_in_segment_ = 0U;
   round_active_ = true;
   eval_cursor_ = 0U;
@@ -574,54 +555,33 @@ void SdpSlam::make_oldest_permanent() {
   if (!graph_.is_live(level)) return;
   // Pending work first (the previous level's releases and transfer, this level's skeletons).
   finish_releases();
-  const std::uint32_t count = levels_[slot(level)].count;
+  const std::uint32_t count = store_.level(level).count;
   for (std::uint32_t k = 0; k < count; ++k) {
-    if (!submap(level, k).skeleton_done) extract_skeleton(level, k);
+    if (!store_.submap(level, k).skeleton_done) extract_skeleton(level, k);
   }
-  rank_particles();
-  const std::uint32_t chosen = choice(order_[0], level);
+  const std::uint32_t chosen = choice(top_.rank(), level);
   const bool had_anchor = graph_.has_anchor();
   const Pose2 previous_frame = graph_.anchor_frame();
   const PgsPermanentResult r = graph_.make_oldest_permanent(chosen);
   if (r.status != PgsStatus::kOk) return;
   ++stats_.levels_made_permanent;
-  const Submap& sm = submap(level, chosen);
+  const Submap& sm = store_.submap(level, chosen);
   // Its poses, in its own frame, and that frame in the global frame.
   if (permanent_sink_ != nullptr) {
     permanent_sink_->on_frame(level, r.frame_in_global);
     for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) { permanent_sink_->on_pose(level, s, p); });
   }
   // Its skeleton joins the permanent ring (the oldest is forgotten when full).
-  if (perm_count_ == options_.max_permanent_submaps) {
-    perm_head_ = (perm_head_ + 1U) % options_.max_permanent_submaps;
-    --perm_count_;
-    ++stats_.permanent_forgotten;
-  }
-  const std::uint32_t pi = (perm_head_ + perm_count_) % options_.max_permanent_submaps;
-  Permanent& pm = perm_[pi];
+  bool forgot = false;
+  PermanentSubmap& pm = store_.permanent(store_.make_permanent(level, chosen, &forgot));
+  if (forgot) ++stats_.permanent_forgotten;
   pm.frame_in_global = r.frame_in_global;
   pm.frame_in_map = r.frame_in_global;  // transfer_.frame below
   pm.from_previous = had_anchor ? between(previous_frame, r.frame_in_global) : Pose2{};
-  for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
-  pm.level = level;
-  pm.start_stamp_us = levels_[slot(level)].start_stamp_us;
-  pm.initial = sm.initial;
-  pm.point_count = sm.point_count;
-  pm.obstacle_count = 0U;
-  if (options_.loop_closure) {
-    const CellPoint* from = live_obstacles(level, chosen);
-    CellPoint* to = perm_obstacles(pi);
-    for (std::uint32_t i = 0; i < sm.obstacle_count; ++i) to[i] = from[i];
-    pm.obstacle_count = sm.obstacle_count;
-  }
-  const Point2* src = live_points(level, chosen);
-  Point2* dst = perm_points(pi);
-  for (std::uint32_t i = 0; i < sm.point_count; ++i) dst[i] = src[i];
-  ++perm_count_;
   // The other submaps of the level are released now; the chosen one once its map has
   // been copied into the global map node.
   for (std::uint32_t k = 0; k < count; ++k) {
-    if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = submap(level, k).node;
+    if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = store_.submap(level, k).node;
   }
   transfer_ = Transfer{};
   transfer_.active = true;
@@ -631,12 +591,12 @@ void SdpSlam::make_oldest_permanent() {
   transfer_.rect = sm.map_rect;
   transfer_.next_row = 0U;
   // Committed poses of the level leave the ring (they are the oldest).
-  const std::int64_t end = levels_[slot(level)].end_stamp_us;
+  const std::int64_t end = store_.level(level).end_stamp_us;
   while (ring_count_ > 0U && ring_[ring_head_].stamp_us <= end) {
     ring_head_ = (ring_head_ + 1U) % ring_capacity_;
     --ring_count_;
   }
-  levels_[slot(level)].count = 0U;
+  store_.level(level).count = 0U;
 }
 
 // One cell of the permanent submap into the permanent map, at its place in the global
@@ -745,8 +705,8 @@ std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
   // Skeletons of the live levels, oldest first, in slices.
   if (skeleton_job_.active) used += skeleton_work(budget_cells - used);
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
-    for (std::uint32_t k = 0; k < levels_[slot(lv)].count && used < budget_cells; ++k) {
-      if (submap(lv, k).skeleton_done) continue;
+    for (std::uint32_t k = 0; k < store_.level(lv).count && used < budget_cells; ++k) {
+      if (store_.submap(lv, k).skeleton_done) continue;
       start_skeleton(lv, k);
       used += skeleton_work(budget_cells - used);
     }
@@ -769,7 +729,7 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
 }
 
 void SdpSlam::start_skeleton(std::uint32_t level, std::uint32_t node) {
-  Submap& sm = submap(level, node);
+  Submap& sm = store_.submap(level, node);
   sm.point_count = 0U;
   sm.obstacle_count = 0U;
   box_init(sm.box);
@@ -797,7 +757,7 @@ void SdpSlam::start_skeleton(std::uint32_t level, std::uint32_t node) {
 std::uint32_t SdpSlam::skeleton_work(std::uint32_t budget_cells) {
   SkeletonJob& job = skeleton_job_;
   if (!job.active) return 0U;
-  Submap& sm = submap(job.level, job.node);
+  Submap& sm = store_.submap(job.level, job.node);
   const CellRect& r = job.rect;
   const std::uint32_t d = options_.skeleton_downsample;
   const std::uint32_t cw = job.coarse_width;
@@ -862,8 +822,8 @@ std::uint32_t SdpSlam::skeleton_work(std::uint32_t budget_cells) {
   SkeletonOptions so;
   so.min_clearance_m = options_.skeleton_min_clearance_m;
   so.max_points = options_.skeleton_points;
-  Point2* out = live_points(job.level, job.node);
-  if (options_.loop_closure) extract_obstacles(sm, live_obstacles(job.level, job.node), r, cw, ch);
+  Point2* out = store_.points(job.level, job.node);
+  if (options_.loop_closure) extract_obstacles(sm, store_.obstacles(job.level, job.node), r, cw, ch);
   const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
   ++stats_.skeletons;
   if (res.status == SkeletonResult::Status::kOk) {
@@ -876,79 +836,8 @@ std::uint32_t SdpSlam::skeleton_work(std::uint32_t budget_cells) {
 
 // ---- top level (lines 10-12) -----------------------------------------------------------
 
-double SdpSlam::key(std::uint32_t p) const { return has_error_[p] != 0U ? error_[p] : options_.prior_error_m; }
-
-void SdpSlam::rank_particles() {
-  for (std::uint32_t i = 0; i < n_top_; ++i) order_[i] = i;
-  // Insertion sort: stable, deterministic, T <= 4096.
-  for (std::uint32_t i = 1; i < n_top_; ++i) {
-    const std::uint32_t v = order_[i];
-    const double kv = key(v);
-    std::uint32_t j = i;
-    while (j > 0U && key(order_[j - 1U]) > kv) {
-      order_[j] = order_[j - 1U];
-      --j;
-    }
-    order_[j] = v;
-  }
-}
-
-void SdpSlam::resample_and_diversify() {
-  const std::uint32_t first = graph_.first_live_level();
-  const std::uint32_t end = graph_.level_end();
-  if (end <= first) return;
-  rank_particles();
-  const std::uint32_t L = options_.max_levels;
-  std::uint32_t elite = static_cast<std::uint32_t>(options_.elite_fraction * static_cast<double>(n_top_));
-  const std::uint32_t worst = static_cast<std::uint32_t>(options_.worst_fraction * static_cast<double>(n_top_));
-  if (elite > n_top_) elite = n_top_;
-  const std::uint32_t best = order_[0];
-  // Worst ranks become copies of the elite (of the best when there is no elite).
-  for (std::uint32_t k = 0; k < worst && k < n_top_ - elite; ++k) {
-    const std::uint32_t dst = order_[n_top_ - 1U - k];
-    const std::uint32_t src = order_[elite > 0U ? k % elite : 0U];
-    if (dst == src) continue;
-    for (std::uint32_t s = 0; s < L; ++s) choices_[dst * L + s] = choices_[src * L + s];
-    error_[dst] = error_[src];
-    has_error_[dst] = has_error_[src];
-  }
-  // Everyone but the elite diversifies.
-  std::uint32_t lo = first;
-  if (options_.topology == TopologyMode::kSegSlam && end - first > options_.segslam_window) {
-    lo = end - options_.segslam_window;
-  }
-  for (std::uint32_t r = elite; r < n_top_; ++r) {
-    const std::uint32_t p = order_[r];
-    if (options_.topology == TopologyMode::kSegSlam) {
-      // Local analysis: chains before the window follow the best sample.
-      for (std::uint32_t lv = first; lv < lo; ++lv) choice(p, lv) = choice(best, lv);
-    }
-    for (std::uint32_t k = 0; k < options_.diversify_levels; ++k) {
-      const std::uint32_t lv = lo + rng_.below(end - lo);
-      const double u = rng_.uniform();
-      PgsPick pick = lv == first ? graph_.sample_first(u) : graph_.sample_next(lv - 1U, choice(p, lv - 1U), u);
-      if (pick.status == PgsStatus::kOk) choice(p, lv) = static_cast<std::uint16_t>(pick.node);
-    }
-  }
-}
-
-void SdpSlam::extend_to_level(std::uint32_t level, std::uint32_t bottom_best) {
-  rank_particles();
-  std::uint32_t follow =
-      static_cast<std::uint32_t>(options_.follow_best_fraction * static_cast<double>(n_top_) + 0.999999);
-  if (follow > n_top_) follow = n_top_;
-  for (std::uint32_t r = 0; r < n_top_; ++r) {
-    const std::uint32_t p = order_[r];
-    if (r < follow) {
-      choice(p, level) = static_cast<std::uint16_t>(bottom_best);
-      continue;
-    }
-    const double u = rng_.uniform();
-    const PgsPick pick = level == graph_.first_live_level() ? graph_.sample_first(u)
-                                                            : graph_.sample_next(level - 1U, choice(p, level - 1U), u);
-    choice(p, level) = static_cast<std::uint16_t>(pick.status == PgsStatus::kOk ? pick.node : bottom_best);
-  }
-}
+// Ranking, elitism, diversification and extension are TopParticles' (top_particles.h);
+// here a combination is evaluated, and each round's outcome published.
 
 void SdpSlam::evaluate(std::uint32_t p) {
   ++stats_.evaluations;
@@ -957,153 +846,36 @@ void SdpSlam::evaluate(std::uint32_t p) {
   if (count == 0U) return;
   for (std::uint32_t i = 0; i < count; ++i) chain_[i] = choice(p, first + i);
   if (graph_.compose_chain(chain_, count, eval_frames_) != PgsStatus::kOk) return;
-  // Candidate pairs: (older, newer), non-adjacent, largest box overlap first.
-  struct Cand {
-    double area;
-    std::int32_t older;  // live level index i (>= 0) or -(permanent ring index + 1)
-    std::uint32_t newer; // live level index
-  };
-  Cand best[64];
-  std::uint32_t nbest = 0U;
-  const std::uint32_t kmax = options_.max_pairs_per_sample;
-  auto consider = [&](double area, std::int32_t older, std::uint32_t newer) {
-    if (area < options_.min_overlap_m2 || area <= 0.0) return;
-    std::uint32_t pos = nbest;
-    while (pos > 0U && best[pos - 1U].area < area) --pos;
-    if (pos >= kmax) return;
-    const std::uint32_t last = nbest < kmax ? nbest : kmax - 1U;
-    for (std::uint32_t k = last; k > pos; --k) best[k] = best[k - 1U];
-    best[pos] = Cand{area, older, newer};
-    if (nbest < kmax) ++nbest;
-  };
-  const double m = options_.overlap_margin_m;
-  double gbox[capacity::kMaxPgsLevels][4];
-  for (std::uint32_t i = 0; i < count; ++i) {
-    const Submap& sm = submap(first + i, chain_[i]);
-    if (!sm.skeleton_done || sm.point_count < options_.icp.min_pairs || !box_valid(sm.box)) {
-      gbox[i][0] = 1.0;
-      gbox[i][2] = -1.0;
-      gbox[i][1] = 1.0;
-      gbox[i][3] = -1.0;
-      continue;
-    }
-    box_transform(eval_frames_[i], sm.box, gbox[i]);
-    gbox[i][0] -= m;
-    gbox[i][1] -= m;
-    gbox[i][2] += m;
-    gbox[i][3] += m;
-  }
-  for (std::uint32_t j = 0; j < count; ++j) {
-    if (!box_valid(gbox[j])) continue;
-    for (std::uint32_t i = 0; i + 2U <= j; ++i) {
-      if (box_valid(gbox[i])) consider(box_overlap_m2(gbox[i], gbox[j]), static_cast<std::int32_t>(i), j);
-    }
-    for (std::uint32_t k = 0; k < perm_count_; ++k) {
-      const std::uint32_t pi = (perm_head_ + k) % options_.max_permanent_submaps;
-      const Permanent& pm = perm_[pi];
-      if (pm.level + 1U >= first + j || pm.point_count < options_.icp.min_pairs) continue;  // adjacent
-      double pb[4];
-      box_transform(pm.frame_in_global, pm.box, pb);
-      consider(box_overlap_m2(pb, gbox[j]), -static_cast<std::int32_t>(pi) - 1, j);
-    }
-  }
-  if (nbest == 0U) return;  // no overlap: the weight is not changed (§IV)
-  double sum = 0.0;
-  double pairs = 0.0;
-  std::uint32_t lo = first + count;
-  std::uint32_t hi = first;
-  for (std::uint32_t k = 0; k < nbest; ++k) {
-    const Cand& c = best[k];
-    const Submap& sn = submap(first + c.newer, chain_[c.newer]);
-    const Point2* target = nullptr;
-    std::uint32_t tcount = 0U;
-    Pose2 tframe;
-    std::uint32_t older_level = first;
-    if (c.older >= 0) {
-      const std::uint32_t i = static_cast<std::uint32_t>(c.older);
-      const Submap& so = submap(first + i, chain_[i]);
-      target = live_points(first + i, chain_[i]);
-      tcount = so.point_count;
-      tframe = eval_frames_[i];
-      older_level = first + i;
+  CombinationResult& r = evaluation_;
+  evaluator_.evaluate(store_, first, chain_, eval_frames_, count, &r);
+  stats_.icp_matches += r.icp_matches;
+  stats_.icp_failures += r.icp_failures;
+  stats_.icp_memo_hits += r.memo_hits;
+  // Loop closure refines each fresh match on obstacle points, from the skeleton match.
+  for (std::uint32_t k = 0; k < r.match_count && options_.loop_closure; ++k) {
+    const CombinationMatch& mt = r.matches[k];
+    const CellPoint* to = nullptr;
+    std::uint32_t tn = 0U;
+    if (mt.older_permanent) {
+      to = store_.permanent_obstacles(mt.older);
+      tn = store_.permanent(mt.older).obstacle_count;
     } else {
-      const std::uint32_t pi = static_cast<std::uint32_t>(-c.older - 1);
-      target = perm_points(pi);
-      tcount = perm_[pi].point_count;
-      tframe = perm_[pi].frame_in_global;
+      to = store_.obstacles(first + mt.older, chain_[mt.older]);
+      tn = store_.submap(first + mt.older, chain_[mt.older]).obstacle_count;
     }
-    const Pose2 guess = tframe.inverse().compose(eval_frames_[c.newer]);
-    // Memo key: older submap (live level/node or permanent slot), newer level/node.
-    const std::uint64_t older_id =
-        c.older >= 0 ? (static_cast<std::uint64_t>(older_level) << 16U) | chain_[c.older]
-                     : (1ULL << 63U) | static_cast<std::uint64_t>(-c.older - 1) << 16U | perm_[-c.older - 1].level;
-    const std::uint64_t key =
-        (older_id * 0x9E3779B97F4A7C15ULL) ^ ((static_cast<std::uint64_t>(first + c.newer) << 16U) | chain_[c.newer]);
-    std::uint64_t gh = key;
-    const double gv[3] = {guess.x_m, guess.y_m, guess.heading_rad};
-    for (double v : gv) {
-      std::uint64_t b = 0U;
-      std::memcpy(&b, &v, sizeof b);
-      gh = splitmix64_next(gh) ^ b;
+    const std::uint32_t newer = first + mt.newer;
+    const std::uint32_t sn_count = store_.submap(newer, chain_[mt.newer]).obstacle_count;
+    if (tn >= options_.loop_min_pairs && sn_count >= options_.loop_min_pairs) {
+      unpack(to, tn, obst_a_);
+      unpack(store_.obstacles(newer, chain_[mt.newer]), sn_count, obst_b_);
+      loop_closure_.refine(mt.older_level, obst_a_, tn, newer, obst_b_, sn_count, mt.guess, mt.transform);
     }
-    gh = splitmix64_next(gh);
-    IcpMemo& memo = memo_[gh % kIcpMemoSlots];
-    double e = 0.0;
-    double w = 0.0;
-    if (memo.valid && memo.key == key && memo.guess_hash == gh) {
-      ++stats_.icp_memo_hits;
-      e = memo.error_m;
-      w = memo.weight;
-    } else {
-      const Icp2dResult r = icp_->match(target, tcount, live_points(first + c.newer, chain_[c.newer]),
-                                        sn.point_count, guess, options_.icp);
-      if (r.usable() && r.matched_pairs > 0U) {
-        ++stats_.icp_matches;
-        e = r.mean_nn_error_m;
-        w = static_cast<double>(r.matched_pairs);
-        if (options_.loop_closure) {
-          // Refine on obstacle points, starting from the skeleton match.
-          const CellPoint* to = nullptr;
-          std::uint32_t tn = 0U;
-          std::uint32_t older = older_level;
-          if (c.older >= 0) {
-            to = live_obstacles(older_level, chain_[c.older]);
-            tn = submap(older_level, chain_[c.older]).obstacle_count;
-          } else {
-            const Permanent& pm = perm_[-c.older - 1];
-            to = perm_obstacles(static_cast<std::uint32_t>(-c.older - 1));
-            tn = pm.obstacle_count;
-            older = pm.level;
-          }
-          const std::uint32_t sn_count = sn.obstacle_count;
-          if (tn >= options_.loop_min_pairs && sn_count >= options_.loop_min_pairs) {
-            unpack(to, tn, obst_a_);
-            unpack(live_obstacles(first + c.newer, chain_[c.newer]), sn_count, obst_b_);
-            loop_closure_.refine(older, obst_a_, tn, first + c.newer, obst_b_, sn_count, guess, r.transform);
-          }
-        }
-        if (options_.icp_correction_weight > 0.0) {
-          const Pose2 d = between(guess, r.transform);
-          e += options_.icp_correction_weight *
-               (det::sqrt(d.x_m * d.x_m + d.y_m * d.y_m) + options_.icp_correction_lever_m * (d.heading_rad < 0.0 ? -d.heading_rad : d.heading_rad));
-        }
-      } else if (r.status == Icp2dResult::Status::kInsufficientOverlap) {
-        ++stats_.icp_failures;
-        e = options_.icp.max_correspondence_m;
-        w = static_cast<double>(options_.icp.min_pairs);
-      }
-      memo = IcpMemo{key, gh, e, w, true};
-    }
-    if (!(w > 0.0)) continue;
-    sum += e * w;
-    pairs += w;
-    if (older_level < lo) lo = older_level;
-    if (first + c.newer > hi) hi = first + c.newer;
   }
-  if (!(pairs > 0.0)) return;
-  const double err = sum / pairs;
-  error_[p] = err;
-  has_error_[p] = 1U;
+  if (!r.measured) return;  // no overlap: the weight is not changed (§IV)
+  const double err = r.error_m;
+  const std::uint32_t lo = r.lo_level;
+  const std::uint32_t hi = r.hi_level;
+  top_.set_error(p, err);
   ++stats_.evaluations_with_overlap;
   stats_.error_sum_m += err;
   stats_.error_sq_sum_m2 += err * err;
@@ -1129,7 +901,7 @@ void SdpSlam::end_round(std::int64_t stamp_us, bool may_continue) {
   }
   update_best();
   if (may_continue && overlap && rounds_in_segment_ < options_.rounds_per_segment) {
-    resample_and_diversify();
+    top_.resample_and_diversify(graph_, rng_);
     update_best();
     round_active_ = true;
     eval_cursor_ = 0U;
@@ -1140,8 +912,7 @@ void SdpSlam::end_round(std::int64_t stamp_us, bool may_continue) {
 }
 
 void SdpSlam::update_best() {
-  rank_particles();
-  best_top_ = order_[0];
+  best_top_ = top_.rank();
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
   if (count == 0U) {
@@ -1151,7 +922,7 @@ void SdpSlam::update_best() {
   for (std::uint32_t i = 0; i < count; ++i) chain_[i] = choice(best_top_, first + i);
   if (graph_.compose_chain(chain_, count, frames_) != PgsStatus::kOk) return;
   if (options_.loop_closure) adjust_frames();
-  const Submap& last = submap(first + count - 1U, chain_[count - 1U]);
+  const Submap& last = store_.submap(first + count - 1U, chain_[count - 1U]);
   // The current segment starts where the last chosen submap ends (Fig. 3 (l)).
   current_frame_ = frames_[count - 1U].compose(last.final_pose.compose(segment_start_pose_.inverse()));
 }
@@ -1204,43 +975,33 @@ void SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
   }
 }
 
-bool SdpSlam::permanent_slot(std::uint32_t level, std::uint32_t* pi) const {
-  if (perm_count_ == 0U) return false;
-  const std::uint32_t oldest = perm_[perm_head_].level;
-  if (level < oldest || level - oldest >= perm_count_) return false;
-  const std::uint32_t k = (perm_head_ + (level - oldest)) % options_.max_permanent_submaps;
-  if (perm_[k].level != level) return false;  // levels are made permanent in order
-  *pi = k;
-  return true;
-}
-
 // Graph order: the permanent submaps held, oldest first, then the live levels. All
 // submaps of a level share the level's frame (the bottom particles restarted at one
 // pose in the map's grid frame), so a constraint between two levels' frames measured
 // with some of their submaps holds for the chosen ones too.
 bool SdpSlam::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const {
   std::uint32_t pi = 0U;
-  if (permanent_slot(level, &pi)) {
-    *stamp_us = perm_[pi].start_stamp_us;
-    *initial = perm_[pi].initial;
+  if (store_.find_permanent(level, &pi)) {
+    *stamp_us = store_.permanent(pi).start_stamp_us;
+    *initial = store_.permanent(pi).initial;
     return true;
   }
   const std::uint32_t first = graph_.first_live_level();
-  if (level < first || level >= first + graph_.live_level_count() || levels_[slot(level)].count == 0U) return false;
-  *stamp_us = levels_[slot(level)].start_stamp_us;
-  *initial = submap(level, 0U).initial;
+  if (level < first || level >= first + graph_.live_level_count() || store_.level(level).count == 0U) return false;
+  *stamp_us = store_.level(level).start_stamp_us;
+  *initial = store_.submap(level, 0U).initial;
   return true;
 }
 
 bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
   std::uint32_t pi = 0U;
-  if (permanent_slot(level, &pi)) {
-    *index = level - perm_[perm_head_].level;
+  if (store_.find_permanent(level, &pi)) {
+    *index = level - store_.first_held_level(level);
     return true;
   }
   const std::uint32_t first = graph_.first_live_level();
   if (level < first || level >= first + graph_.live_level_count()) return false;
-  *index = perm_count_ + (level - first);
+  *index = store_.permanent_count() + (level - first);
   return true;
 }
 
@@ -1253,15 +1014,15 @@ void SdpSlam::adjust_frames() {
   FrameGraph& g = loop_closure_.begin_adjustment();
   const FrameInfo seg = FrameInfo::from_sigma(options_.segment_sigma_xy_m, options_.segment_sigma_theta_rad);
   bool ok = true;
-  for (std::uint32_t k = 0; k < perm_count_; ++k) {
-    const Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
+  for (std::uint32_t k = 0; k < store_.permanent_count(); ++k) {
+    const PermanentSubmap& pm = store_.permanent(store_.permanent_slot_at(k));
     ok = ok && g.add_node(pm.frame_in_global, pm.from_previous, seg);
   }
   for (std::uint32_t i = 0; i < count && ok; ++i) {
     Pose2 t;
     if (i > 0U) {
       ok = graph_.transform_between(first + i - 1U, chain_[i - 1U], chain_[i], t) == PgsStatus::kOk;
-    } else if (perm_count_ > 0U) {
+    } else if (store_.permanent_count() > 0U) {
       t = between(graph_.anchor_frame(), frames_[0]);
     }
     ok = ok && g.add_node(frames_[i], t, seg);
@@ -1272,8 +1033,8 @@ void SdpSlam::adjust_frames() {
   }
   if (!loop_closure_.finish_adjustment()) return;  // the chain alone is already consistent
   double offset = 0.0;
-  for (std::uint32_t k = 0; k < perm_count_; ++k) {
-    Permanent& pm = perm_[(perm_head_ + k) % options_.max_permanent_submaps];
+  for (std::uint32_t k = 0; k < store_.permanent_count(); ++k) {
+    PermanentSubmap& pm = store_.permanent(store_.permanent_slot_at(k));
     pm.frame_in_global = g.frame(k);
     if (permanent_sink_ != nullptr) permanent_sink_->on_frame(pm.level, pm.frame_in_global);
     const double d = frame_offset_m(pm.frame_in_map, pm.frame_in_global, pm.box);
@@ -1281,8 +1042,8 @@ void SdpSlam::adjust_frames() {
   }
   stats_.permanent_map_offset_m = offset;
   if (offset > stats_.permanent_map_offset_max_m) stats_.permanent_map_offset_max_m = offset;
-  if (perm_count_ > 0U) graph_.set_anchor_frame(g.frame(perm_count_ - 1U));
-  for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(perm_count_ + i);
+  if (store_.permanent_count() > 0U) graph_.set_anchor_frame(g.frame(store_.permanent_count() - 1U));
+  for (std::uint32_t i = 0; i < count; ++i) frames_[i] = g.frame(store_.permanent_count() + i);
 }
 
 // ---- the submaps as loop closure sees them (loop_closure.h) ----------------------------
@@ -1290,9 +1051,9 @@ void SdpSlam::adjust_frames() {
 bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
                               double box[4]) const {
   std::uint32_t pi = 0U;
-  if (permanent_slot(level, &pi)) {
-    const Permanent& pm = perm_[pi];
-    *points = perm_obstacles(pi);
+  if (store_.find_permanent(level, &pi)) {
+    const PermanentSubmap& pm = store_.permanent(pi);
+    *points = store_.permanent_obstacles(pi);
     *count = pm.obstacle_count;
     *frame = pm.frame_in_global;
     for (int i = 0; i < 4; ++i) box[i] = pm.box[i];
@@ -1301,9 +1062,9 @@ bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std
   const std::uint32_t first = graph_.first_live_level();
   if (level < first || level >= first + graph_.live_level_count()) return false;
   const std::uint32_t node = choice(best_top_, level);
-  const Submap& sm = submap(level, node);
+  const Submap& sm = store_.submap(level, node);
   if (!sm.skeleton_done) return false;
-  *points = live_obstacles(level, node);
+  *points = store_.obstacles(level, node);
   *count = sm.obstacle_count;
   *frame = frames_[level - first];
   for (int i = 0; i < 4; ++i) box[i] = sm.box[i];
@@ -1311,7 +1072,7 @@ bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std
 }
 
 std::uint32_t SdpSlam::first_held_level() const {
-  return perm_count_ > 0U ? perm_[perm_head_].level : graph_.first_live_level();
+  return store_.first_held_level(graph_.first_live_level());
 }
 
 bool SdpSlam::placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const {

@@ -144,8 +144,7 @@ void SdpSlam::transfer_state(StateIo& io) {
   skeleton_.transfer_state(io);
   rng_.transfer_state(io);
   io.value(stats_);
-  io.value(perm_head_);
-  io.value(perm_count_);
+  store_.transfer_state(io);
   io.value(ring_head_);
   io.value(ring_count_);
   loop_closure_.transfer_state(io);

@@ -1,5 +1,6 @@
-// No heap after init: ICP matching, skeleton extraction and every PGS operation run
-// inside an allocation-counting scope once their storage is set up.
+// No heap after init: ICP matching, skeleton extraction, every PGS operation and the
+// top-level particles' resampling run inside an allocation-counting scope once their
+// storage is set up.
 #include <CppUTest/TestHarness.h>
 
 #include "alloc_counter.h"
@@ -7,6 +8,7 @@
 #include "sdpslam/core/top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/top/segment_graph.h"
+#include "sdpslam/core/top/top_particles.h"
 #include "top_level_fixtures.h"
 
 namespace {
@@ -30,6 +32,11 @@ TEST(TopLevelNoHeap, icp_skeleton_and_segment_graph_never_allocate_after_init) {
   options.nodes_per_level = 10U;
   SegmentGraph graph;
   CHECK_TRUE(graph.init(options, arena));
+  SdpOptions sdp;
+  sdp.max_levels = options.max_levels;
+  TopParticles top;
+  CHECK_TRUE(top.init(TopParticleOptions::from(sdp), arena));
+  Rng top_rng(5U);
   CHECK_TRUE(test::allocation_counting_active());
 
   test::AllocationScope scope;
@@ -59,6 +66,9 @@ TEST(TopLevelNoHeap, icp_skeleton_and_segment_graph_never_allocate_after_init) {
       CHECK_TRUE(graph.make_oldest_permanent(graph.sample_first(rng.uniform()).node).status == PgsStatus::kOk);
       CHECK_TRUE(graph.add_level(nodes, 10U).status == PgsStatus::kOk);
     }
+    top.resample_and_diversify(graph, top_rng);
+    top.extend_to_level(graph.level_end() - 1U, 0U, graph, top_rng);
+    top.set_error(static_cast<std::uint32_t>(step) % top.size(), rng.uniform());
     if (graph.levels_used() < 2U) continue;
     std::uint32_t chain[4];
     chain[0] = graph.sample_first(rng.uniform()).node;

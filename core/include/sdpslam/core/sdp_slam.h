@@ -25,26 +25,17 @@
 // Top level (lines 7-12): the PGS (segment_graph.h) gets one level per segment, one node
 // per bottom particle. At anchorage every node's free-space skeleton (Fig. 2 (b)) is
 // extracted from its DP-map view around its path, in the submap frame, into fixed
-// storage. T top-level particles each hold one submap choice per live level. After a
-// segmentation they are resampled with ELITISM (the best elite_fraction are kept, the
-// worst worst_fraction replaced by copies of the elite, all but the elite diversify by
-// re-sampling choices from the PGS with conditional sampling p(b | a)), extended to the
-// new level, and evaluated: the combination's submaps are placed in one frame by
-// composing T; non-adjacent submaps whose global bounding boxes overlap (at most
-// max_pairs_per_sample pairs, largest overlap first, permanent submaps included) are
-// matched with ICP on their skeleton points from the composed chain as initial guess;
-// the sample's error is the mean nearest-neighbour distance over all matched point
-// pairs ("ICP nearest neighbour error"). A pair whose boxes overlap but whose ICP finds
-// too few correspondences counts as icp.max_correspondence_m (a gross misalignment must
-// not look like "no overlap"). The error weights the particle (lower is better) and is
-// added to the PGS edges of the combination between the oldest and newest live level
-// involved (line 12, equation (4)). Samples without any overlap keep their weight
-// ("in the rest of the process the weights are not changed", §IV). Up to
-// rounds_per_segment rounds run after each segmentation, as long as samples overlap.
-//
-// SegSLAM topology (§IV comparison, TopologyMode::kSegSlam): identical except that
-// diversification re-samples only the last segslam_window levels and older choices
-// follow the best particle's (a local analysis of chains of few segments).
+// storage (submap_store.h). T top-level particles (top_particles.h) each hold one
+// submap choice per live level: after a segmentation they are resampled with elitism
+// and diversified from the PGS (or, with SegSLAM's topology, only over its last
+// levels), extended to the new level, and evaluated, evaluations_per_scan per call of
+// process(): a combination's error is the ICP nearest-neighbour error of its
+// overlapping non-adjacent submaps, permanent ones included (combination_evaluator.h).
+// The error weights the particle (lower is better) and is added to the PGS edges of the
+// combination between the oldest and newest live level involved (line 12, equation
+// (4)). Samples without any overlap keep their weight ("in the rest of the process the
+// weights are not changed", §IV). Up to rounds_per_segment rounds run after each
+// segmentation, as long as samples overlap.
 //
 // Bounded memory: when all max_levels PGS levels are live, the oldest becomes PERMANENT
 // with the best top particle's choice: that submap's poses go to the permanent path
@@ -95,8 +86,11 @@
 #include "sdpslam/core/loops/loop_closure.h"
 #include "sdpslam/core/top/permanent_map.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/top/combination_evaluator.h"
 #include "sdpslam/core/top/segment_graph.h"
 #include "sdpslam/core/top/segmentation.h"
+#include "sdpslam/core/top/submap_store.h"
+#include "sdpslam/core/top/top_particles.h"
 
 namespace sdpslam {
 
@@ -257,7 +251,7 @@ class SdpSlam {
     std::uint32_t index = 0U;
     return graph_index(level, &index);
   }
-  std::uint32_t permanent_submap_count() const { return perm_count_; }
+  std::uint32_t permanent_submap_count() const { return store_.permanent_count(); }
   std::uint32_t pose_ring_capacity() const { return ring_capacity_; }
   std::size_t arena_bytes_used() const { return arena_used_; }
   // Mean/std of the ICP error over the top-level particles that have one (0 if none).
@@ -289,50 +283,6 @@ class SdpSlam {
     std::int64_t stamp_us;
     Pose2 pose;
   };
-  struct Submap {
-    NodeId node = kNoNode;
-    Pose2 initial;
-    Pose2 final_pose;
-    double box[4] = {0.0, 0.0, 0.0, 0.0};  // skeleton points' bounds, submap frame
-    CellRect map_rect{};                    // cells worth reading for its map
-    CellRect path_rect{};                   // its path's cells (skeleton patch seed)
-    std::uint32_t point_count = 0U;
-    std::uint32_t obstacle_count = 0U;  // loop closure's obstacle points
-    bool skeleton_done = false;
-  };
-  struct Level {
-    std::int64_t start_stamp_us = 0;  // exclusive (the previous segment's last scan)
-    std::int64_t end_stamp_us = 0;    // inclusive
-    std::uint32_t count = 0U;
-  };
-  struct Permanent {
-    Pose2 frame_in_global;
-    Pose2 frame_in_map;  // the frame its map was copied into the global map node with
-    Pose2 from_previous;  // this frame in the previous permanent level's frame (chain T)
-    double box[4] = {0.0, 0.0, 0.0, 0.0};
-    std::uint32_t level = 0U;
-    std::uint32_t point_count = 0U;
-    std::uint32_t obstacle_count = 0U;
-    std::int64_t start_stamp_us = 0;  // level_origin()
-    Pose2 initial;
-  };
-  // An obstacle point in half DP-map cells from the map's origin (the submap frame is the
-  // map's grid frame).
-  struct CellPoint {
-    std::uint16_t ix = 0U;
-    std::uint16_t iy = 0U;
-  };
-  // Memo of ICP results: many samples share a pair of submaps placed identically (elite
-  // copies, common chains), and ICP is deterministic, so the same inputs give the same
-  // result. Direct-mapped, keyed by the two submaps and the bits of the initial guess.
-  struct IcpMemo {
-    std::uint64_t key = 0U;
-    std::uint64_t guess_hash = 0U;
-    double error_m = 0.0;
-    double weight = 0.0;  // matched pairs; 0 = no usable result
-    bool valid = false;
-  };
-  static constexpr std::uint32_t kIcpMemoSlots = 1024U;
   // A skeleton being read from the DP map a strip of coarse rows at a time.
   struct SkeletonJob {
     bool active = false;
@@ -371,32 +321,10 @@ class SdpSlam {
     SdpSlam& owner_;
   };
 
-  std::uint32_t slot(std::uint32_t level) const { return level % options_.max_levels; }
-  Submap& submap(std::uint32_t level, std::uint32_t node) { return submaps_[slot(level) * n_bottom_ + node]; }
-  const Submap& submap(std::uint32_t level, std::uint32_t node) const {
-    return submaps_[slot(level) * n_bottom_ + node];
-  }
-  Point2* live_points(std::uint32_t level, std::uint32_t node) const {
-    return live_points_ + (static_cast<std::size_t>(slot(level)) * n_bottom_ + node) * options_.skeleton_points;
-  }
-  Point2* perm_points(std::uint32_t index) const {
-    return perm_points_ + static_cast<std::size_t>(index) * options_.skeleton_points;
-  }
-  CellPoint* live_obstacles(std::uint32_t level, std::uint32_t node) const {
-    return live_obst_ + (static_cast<std::size_t>(slot(level)) * n_bottom_ + node) * options_.loop_points;
-  }
-  CellPoint* perm_obstacles(std::uint32_t index) const {
-    return perm_obst_ + static_cast<std::size_t>(index) * options_.loop_points;
-  }
   void extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch);
   // Cell points → metres in the submap frame (scratch buffer).
   void unpack(const CellPoint* in, std::uint32_t n, Point2* out) const;
-  std::uint16_t& choice(std::uint32_t particle, std::uint32_t level) {
-    return choices_[particle * options_.max_levels + slot(level)];
-  }
-  std::uint16_t choice(std::uint32_t particle, std::uint32_t level) const {
-    return choices_[particle * options_.max_levels + slot(level)];
-  }
+  std::uint16_t choice(std::uint32_t particle, std::uint32_t level) const { return top_.choice(particle, level); }
 
   void ring_push(std::int64_t stamp_us, const Pose2& pose);
   template <class F>
@@ -420,15 +348,9 @@ class SdpSlam {
   std::uint32_t transfer_rows(std::uint32_t budget_cells);
   void transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v);
   std::uint32_t release_one();
-  void rank_particles();
-  void resample_and_diversify();
-  void extend_to_level(std::uint32_t level, std::uint32_t bottom_best);
   void evaluate(std::uint32_t particle);
   void end_round(std::int64_t stamp_us, bool may_continue);
   void update_best();
-  double key(std::uint32_t particle) const;
-  // Ring index of permanent level `level` if it is still held.
-  bool permanent_slot(std::uint32_t level, std::uint32_t* pi) const;
   // Index of a level's frame in the best combination's frame graph, if it is part of it.
   bool graph_index(std::uint32_t level, std::uint32_t* index) const;
   void adjust_frames();
@@ -448,7 +370,7 @@ class SdpSlam {
    public:
     explicit LoopView(SdpSlam& owner) : owner_(owner) {}
     bool node_index(std::uint32_t level, std::uint32_t* index) const override { return owner_.graph_index(level, index); }
-    std::uint32_t node_count() const override { return owner_.perm_count_ + owner_.graph_.live_level_count(); }
+    std::uint32_t node_count() const override { return owner_.store_.permanent_count() + owner_.graph_.live_level_count(); }
     std::uint32_t first_held_level() const override { return owner_.first_held_level(); }
     std::uint32_t first_live_level() const override { return owner_.graph_.first_live_level(); }
     std::uint32_t level_end() const override { return owner_.graph_.level_end(); }
@@ -476,19 +398,10 @@ class SdpSlam {
   SdpStats stats_{};
 
   std::uint32_t n_bottom_ = 0U;
-  std::uint32_t n_top_ = 0U;
-  Submap* submaps_ = nullptr;       // max_levels × N
-  Point2* live_points_ = nullptr;   // max_levels × N × skeleton_points
-  Level* levels_ = nullptr;         // max_levels
-  Permanent* perm_ = nullptr;       // ring of max_permanent_submaps
-  Point2* perm_points_ = nullptr;
-  std::uint32_t perm_head_ = 0U;
-  std::uint32_t perm_count_ = 0U;
-  std::uint16_t* choices_ = nullptr;   // T × max_levels (by level slot)
-  std::uint16_t* scratch_choices_ = nullptr;  // T × max_levels (elitism copies)
-  double* error_ = nullptr;            // T
-  std::uint8_t* has_error_ = nullptr;  // T
-  std::uint32_t* order_ = nullptr;     // T, rank → particle
+  SubmapStore store_;                  // live and permanent submaps
+  TopParticles top_;                   // the T combinations (lines 9-12)
+  CombinationEvaluator evaluator_;     // a combination's ICP error (line 11)
+  CombinationResult evaluation_{};     // scratch of evaluate()
   std::uint32_t* chain_ = nullptr;     // max_levels
   Pose2* frames_ = nullptr;            // max_levels: the best particle's chain
   Pose2* eval_frames_ = nullptr;       // max_levels: the chain being evaluated
@@ -502,9 +415,6 @@ class SdpSlam {
   std::size_t fine_cells_ = 0U;
   CellState* coarse_ = nullptr;
   std::uint32_t coarse_side_ = 0U;
-  IcpMemo* memo_ = nullptr;  // kIcpMemoSlots
-  CellPoint* live_obst_ = nullptr;  // max_levels × N × loop_points
-  CellPoint* perm_obst_ = nullptr;  // max_permanent_submaps × loop_points
   Point2* obst_a_ = nullptr;        // loop_points (scratch)
   Point2* obst_b_ = nullptr;
   LoopClosure loop_closure_;
@@ -557,7 +467,7 @@ class SdpSlam {
 
 template <class F>
 void SdpSlam::for_each_level_pose(std::uint32_t level, NodeId leaf, F&& f) const {
-  const Level& lv = levels_[slot(level)];
+  const SubmapLevel& lv = store_.level(level);
   for (std::uint32_t k = 0; k < ring_count_; ++k) {
     const StampedPose& e = ring_[(ring_head_ + k) % ring_capacity_];
     if (e.stamp_us > lv.start_stamp_us && e.stamp_us <= lv.end_stamp_us) f(e.stamp_us, e.pose);
@@ -582,7 +492,7 @@ void SdpSlam::for_each_best_pose(F&& f) const {
   for (std::uint32_t i = 0; i < count; ++i) {
     const std::uint32_t level = first + i;
     const Pose2 frame = frames_[i];
-    const Submap& sm = submap(level, choice(best_top_, level));
+    const Submap& sm = store_.submap(level, choice(best_top_, level));
     for_each_level_pose(level, sm.node, [&](std::int64_t s, const Pose2& p) { f(s, frame.compose(p)); });
   }
   const Pose2 cur = current_frame_;
@@ -592,19 +502,19 @@ void SdpSlam::for_each_best_pose(F&& f) const {
 template <class F>
 void SdpSlam::for_each_best_submap(F&& f) const {
   if (!initialised_ || !started_) return;
-  if (transfer_.active && perm_count_ > 0U) {
+  if (transfer_.active && store_.permanent_count() > 0U) {
     // What the permanent map does not hold yet: a popped node keeps only the cells not
     // copied; in strips, the rows not copied. At its level's frame now (the newest
     // permanent submap).
     CellRect rest = transfer_.rect;
     rest.iy0 += static_cast<std::int32_t>(transfer_.next_row);
     rest.height -= transfer_.next_row;
-    f(transfer_.node, perm_[(perm_head_ + perm_count_ - 1U) % options_.max_permanent_submaps].frame_in_global, rest);
+    f(transfer_.node, store_.permanent(store_.permanent_slot_at(store_.permanent_count() - 1U)).frame_in_global, rest);
   }
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
   for (std::uint32_t i = 0; i < count; ++i) {
-    const Submap& sm = submap(first + i, choice(best_top_, first + i));
+    const Submap& sm = store_.submap(first + i, choice(best_top_, first + i));
     f(sm.node, frames_[i], sm.map_rect);
   }
   const double pad = bottom_options_.beam.max_update_range_m;
@@ -614,18 +524,15 @@ void SdpSlam::for_each_best_submap(F&& f) const {
 template <class F>
 void SdpSlam::for_each_permanent_cell(F&& f) const {
   if (!initialised_) return;
-  // Levels in the ring are consecutive (the oldest live level is made permanent each
-  // time), so a tag finds its entry by offset from the oldest one still held.
-  const std::uint32_t first_level = perm_count_ > 0U ? perm_[perm_head_].level : 0U;
   std::uint32_t last_tag = 0U;
   Pose2 correction;
   permanent_map_.for_each_cell([&](std::int32_t ix, std::int32_t iy, const PermanentMap::Cell& c) {
     if (c.tag != last_tag) {
       last_tag = c.tag;
       correction = Pose2{};
-      const std::uint32_t level = c.tag - 1U;
-      if (level >= first_level && level - first_level < perm_count_) {
-        const Permanent& pm = perm_[(perm_head_ + (level - first_level)) % options_.max_permanent_submaps];
+      std::uint32_t slot = 0U;
+      if (store_.find_permanent(c.tag - 1U, &slot)) {  // a tag is its level + 1
+        const PermanentSubmap& pm = store_.permanent(slot);
         correction = pm.frame_in_global.compose(pm.frame_in_map.inverse());
       }
     }

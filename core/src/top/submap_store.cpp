@@ -1,0 +1,89 @@
+#include "sdpslam/core/top/submap_store.h"
+
+namespace sdpslam {
+
+bool SubmapStoreOptions::valid() const {
+  return max_levels >= 1U && nodes >= 1U && skeleton_points >= 1U && max_permanent >= 1U;
+}
+
+std::size_t SubmapStore::required_bytes(const SubmapStoreOptions& o) {
+  if (!o.valid()) return 0U;
+  const std::size_t live = std::size_t{o.max_levels} * o.nodes;
+  std::size_t total = Arena::bytes_for<Submap>(live) + Arena::bytes_for<Point2>(live * o.skeleton_points) +
+                      Arena::bytes_for<SubmapLevel>(o.max_levels) + Arena::bytes_for<PermanentSubmap>(o.max_permanent) +
+                      Arena::bytes_for<Point2>(std::size_t{o.max_permanent} * o.skeleton_points);
+  if (o.obstacle_points > 0U) {
+    total += Arena::bytes_for<CellPoint>((live + o.max_permanent) * std::size_t{o.obstacle_points});
+  }
+  return total;
+}
+
+bool SubmapStore::init(const SubmapStoreOptions& o, Arena& arena) {
+  submaps_ = nullptr;
+  if (!o.valid() || arena.available_bytes() < required_bytes(o)) return false;
+  const std::size_t live = std::size_t{o.max_levels} * o.nodes;
+  Submap* submaps = arena.allocate_array<Submap>(live);
+  points_ = arena.allocate_array<Point2>(live * o.skeleton_points);
+  levels_ = arena.allocate_array<SubmapLevel>(o.max_levels);
+  perm_ = arena.allocate_array<PermanentSubmap>(o.max_permanent);
+  perm_points_ = arena.allocate_array<Point2>(std::size_t{o.max_permanent} * o.skeleton_points);
+  obstacles_ = nullptr;
+  perm_obstacles_ = nullptr;
+  if (o.obstacle_points > 0U) {
+    // One block: the live submaps' points, then the permanent ones'.
+    obstacles_ = arena.allocate_array<CellPoint>((live + o.max_permanent) * std::size_t{o.obstacle_points});
+    if (obstacles_ == nullptr) return false;
+    perm_obstacles_ = obstacles_ + live * o.obstacle_points;
+  }
+  if (submaps == nullptr || points_ == nullptr || levels_ == nullptr || perm_ == nullptr || perm_points_ == nullptr) {
+    return false;
+  }
+  options_ = o;
+  submaps_ = submaps;
+  for (std::size_t i = 0; i < live; ++i) submaps_[i] = Submap{};
+  for (std::uint32_t i = 0; i < o.max_levels; ++i) levels_[i] = SubmapLevel{};
+  for (std::uint32_t i = 0; i < o.max_permanent; ++i) perm_[i] = PermanentSubmap{};
+  perm_head_ = 0U;
+  perm_count_ = 0U;
+  return true;
+}
+
+bool SubmapStore::find_permanent(std::uint32_t level, std::uint32_t* slot) const {
+  if (perm_count_ == 0U) return false;
+  const std::uint32_t oldest = perm_[perm_head_].level;
+  if (level < oldest || level - oldest >= perm_count_) return false;
+  const std::uint32_t k = permanent_slot_at(level - oldest);
+  if (perm_[k].level != level) return false;  // levels are made permanent in order
+  *slot = k;
+  return true;
+}
+
+std::uint32_t SubmapStore::make_permanent(std::uint32_t level, std::uint32_t node, bool* forgot) {
+  *forgot = perm_count_ == options_.max_permanent;
+  if (*forgot) {
+    perm_head_ = (perm_head_ + 1U) % options_.max_permanent;
+    --perm_count_;
+  }
+  const std::uint32_t slot = permanent_slot_at(perm_count_);
+  const Submap& sm = submap(level, node);
+  PermanentSubmap& pm = perm_[slot];
+  pm = PermanentSubmap{};
+  for (int i = 0; i < 4; ++i) pm.box[i] = sm.box[i];
+  pm.level = level;
+  pm.start_stamp_us = this->level(level).start_stamp_us;
+  pm.initial = sm.initial;
+  pm.point_count = sm.point_count;
+  const Point2* src = points(level, node);
+  Point2* dst = permanent_points(slot);
+  for (std::uint32_t i = 0; i < sm.point_count; ++i) dst[i] = src[i];
+  if (obstacles_ != nullptr) {
+    const CellPoint* from = obstacles(level, node);
+    CellPoint* to = permanent_obstacles(slot);
+    for (std::uint32_t i = 0; i < sm.obstacle_count; ++i) to[i] = from[i];
+    pm.obstacle_count = sm.obstacle_count;
+  }
+  ++perm_count_;
+  return slot;
+}
+
+}  // namespace sdpslam
