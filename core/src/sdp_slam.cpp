@@ -32,6 +32,18 @@ LoopSearchGeometry search_geometry(const DpSlamOptions& b, const SdpOptions& s) 
 // The loop-closure graph holds every permanent submap still kept and every live level.
 std::uint32_t graph_nodes(const SdpOptions& s) { return s.max_permanent_submaps + s.max_levels; }
 
+SkeletonReaderOptions skeleton_options(const DpSlamOptions& b, const SdpOptions& s) {
+  SkeletonReaderOptions o;
+  o.patch_side = coarse_side_cells(b, s);
+  o.downsample = s.skeleton_downsample;
+  o.skeleton_points = s.skeleton_points;
+  o.obstacle_points = s.loop_closure ? s.loop_points : 0U;
+  o.occupied_threshold = s.occupied_threshold;
+  o.free_threshold = s.free_threshold;
+  o.min_clearance_m = s.skeleton_min_clearance_m;
+  return o;
+}
+
 // Obstacle points are kept for loop closure only.
 SubmapStoreOptions store_options(const SdpOptions& s, std::uint32_t n) {
   SubmapStoreOptions o;
@@ -115,11 +127,10 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   const std::size_t n = b.particle_count;
   const std::size_t L = s.max_levels;
   const std::size_t fine = static_cast<std::size_t>(fine_side_cells(b, s)) * fine_side_cells(b, s);
-  const std::size_t cs = coarse_side_cells(b, s);
   const std::size_t pb = PermanentMap::required_bytes(s.permanent_map_tiles);
   if (pb == 0U) return 0U;
   std::size_t total = fb + gb + pb + Arena::bytes_for<DpSlamFilter>(1U) + Arena::bytes_for<Icp2d>(1U) + Arena::bytes_for<Segmenter>(1U);
-  total += FreeSpaceSkeleton::required_bytes(static_cast<std::uint32_t>(cs), static_cast<std::uint32_t>(cs));
+  total += SkeletonReader::required_bytes(skeleton_options(b, s));
   total += SubmapStore::required_bytes(store_options(s, b.particle_count));
   total += TopParticles::required_bytes(TopParticleOptions::from(s));
   total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
@@ -128,7 +139,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
     total += LoopClosure::required_bytes(s, graph_nodes(s), search_geometry(b, s));
     total += 2U * Arena::bytes_for<Point2>(s.loop_points);
   }
-  total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine) + Arena::bytes_for<CellState>(cs * cs);
+  total += Arena::bytes_for<CellObservation>(fine) + Arena::bytes_for<std::uint8_t>(fine);
   return total + kSlack;
 }
 
@@ -219,9 +230,8 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
     std::snprintf(why_, sizeof why_, "PGS init failed");
     return false;
   }
-  coarse_side_ = coarse_side_cells(b, s);
-  if (!skeleton_.init(arena, coarse_side_, coarse_side_)) {
-    std::snprintf(why_, sizeof why_, "skeleton init failed (patch side %u cells)", coarse_side_);
+  if (!skeletons_.init(skeleton_options(b, s), arena)) {
+    std::snprintf(why_, sizeof why_, "skeleton init failed (patch side %u cells)", coarse_side_cells(b, s));
     return false;
   }
   const std::uint32_t L = s.max_levels;
@@ -257,10 +267,9 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   fine_cells_ = static_cast<std::size_t>(fs) * fs;
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
   fine_known_ = arena.allocate_array<std::uint8_t>(fine_cells_);
-  coarse_ = arena.allocate_array<CellState>(std::size_t{coarse_side_} * coarse_side_);
   if (chain_ == nullptr || frames_ == nullptr ||
       eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
-      fine_known_ == nullptr || coarse_ == nullptr || release_queue_ == nullptr) {
+      fine_known_ == nullptr || release_queue_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
   }
@@ -547,7 +556,7 @@ std::uint64_t SdpSlam::scan_burst() const {
 // The pending releases and the permanent submap's copy, all now.
 void SdpSlam::finish_releases() {
   while (release_count_ > 0U) release_one();
-  while (transfer_.active) transfer_rows(0xFFFFFFFFU);
+  while (transfer_.active()) transfer_step(0xFFFFFFFFU);
 }
 
 void SdpSlam::make_oldest_permanent() {
@@ -576,20 +585,14 @@ void SdpSlam::make_oldest_permanent() {
   PermanentSubmap& pm = store_.permanent(store_.make_permanent(level, chosen, &forgot));
   if (forgot) ++stats_.permanent_forgotten;
   pm.frame_in_global = r.frame_in_global;
-  pm.frame_in_map = r.frame_in_global;  // transfer_.frame below
+  pm.frame_in_map = r.frame_in_global;  // the map transfer's frame below
   pm.from_previous = had_anchor ? between(previous_frame, r.frame_in_global) : Pose2{};
   // The other submaps of the level are released now; the chosen one once its map has
   // been copied into the global map node.
   for (std::uint32_t k = 0; k < count; ++k) {
     if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = store_.submap(level, k).node;
   }
-  transfer_ = Transfer{};
-  transfer_.active = true;
-  transfer_.node = sm.node;
-  transfer_.frame = r.frame_in_global;
-  transfer_.tag = level + 1U;
-  transfer_.rect = sm.map_rect;
-  transfer_.next_row = 0U;
+  transfer_.start(sm.node, r.frame_in_global, level + 1U, sm.map_rect);
   // Committed poses of the level leave the ring (they are the oldest).
   const std::int64_t end = store_.level(level).end_stamp_us;
   while (ring_count_ > 0U && ring_[ring_head_].stamp_us <= end) {
@@ -599,88 +602,16 @@ void SdpSlam::make_oldest_permanent() {
   store_.level(level).count = 0U;
 }
 
-// One cell of the permanent submap into the permanent map, at its place in the global
-// frame (the DP map's cell frame: same origin and resolution, no edge), tagged with its
-// level; counted, and counted as dropped when refused (every tile taken) or too far out
-// for int32 cells.
-void SdpSlam::transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v) {
-  const DpMap& map = filter_->map();
-  double cx = 0.0;
-  double cy = 0.0;
-  map.cell_center(ix, iy, &cx, &cy);
-  double gx = 0.0;
-  double gy = 0.0;
-  transfer_.frame.transform_point(cx, cy, gx, gy);
-  ++stats_.map_transfer_cells;
-  const double fx = std::floor((gx - map.options().origin_x_m) / map.resolution_m());
-  const double fy = std::floor((gy - map.options().origin_y_m) / map.resolution_m());
-  constexpr double kLimit = 1073741824.0;  // 2^30 cells
-  if (!(fx > -kLimit && fx < kLimit && fy > -kLimit && fy < kLimit) ||
-      !permanent_map_.add(static_cast<std::int32_t>(fx), static_cast<std::int32_t>(fy), v.hits, v.misses,
-                          transfer_.tag)) {
-    ++stats_.map_transfer_dropped;
-  }
-}
-
-std::uint32_t SdpSlam::transfer_rows(std::uint32_t budget_cells) {
-  if (!transfer_.active) return 0U;
-  const DpMap& map = filter_->map();
-  const std::uint32_t held = map.observations_used();
-  const CellRect& r = transfer_.rect;
-  std::uint32_t used = 0U;
-  if (r.width == 0U || !permanent_map_.initialised()) {
-    transfer_.next_row = r.height;
-  }
-  if (transfer_.mode == TransferMode::kUndecided) {
-    // Called once the level's other submaps are released (do_work, make_oldest_permanent).
-    const bool root = filter_->tree().parent(transfer_.node) == kNoNode;
-    transfer_.mode = root ? TransferMode::kPop : TransferMode::kRows;
-    ++(root ? stats_.map_transfers_popped : stats_.map_transfers_by_rows);
-  }
-  if (transfer_.mode == TransferMode::kPop && transfer_.next_row < r.height) {
-    std::int32_t ix = 0;
-    std::int32_t iy = 0;
-    CellObservation v{};
-    bool more = true;
-    // Popped cells come in window coordinates; the submap's are those near its rectangle.
-    const std::int32_t mid_x = r.ix0 + static_cast<std::int32_t>(r.width / 2U);
-    const std::int32_t mid_y = r.iy0 + static_cast<std::int32_t>(r.height / 2U);
-    while (used < budget_cells && (more = filter_->pop_anchored_observation(transfer_.node, &ix, &iy, &v))) {
-      used += kPopCostCells;
-      map.unwrap_near(&ix, &iy, mid_x, mid_y);
-      transfer_cell(ix, iy, v);
-    }
-    if (!more) transfer_.next_row = r.height;
-  }
-  while (transfer_.mode == TransferMode::kRows && transfer_.next_row < r.height && used < budget_cells) {
-    // A strip fits the work buffers and what is left of the budget (at least one row).
-    std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / r.width);
-    const std::uint32_t budget_rows = (budget_cells - used) / r.width;
-    if (budget_rows < rows) rows = budget_rows;
-    if (rows == 0U) rows = 1U;
-    if (rows > r.height - transfer_.next_row) rows = r.height - transfer_.next_row;
-    CellRect strip = r;
-    strip.iy0 = r.iy0 + static_cast<std::int32_t>(transfer_.next_row);
-    strip.height = rows;
-    if (static_cast<std::size_t>(strip.width) * rows > fine_cells_) strip.width = static_cast<std::uint32_t>(fine_cells_);
-    map.fill_rect(transfer_.node, strip, fine_values_, fine_known_);
-    for (std::uint32_t y = 0; y < rows; ++y) {
-      for (std::uint32_t x = 0; x < strip.width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * strip.width + x;
-        if (fine_known_[i] == 0U) continue;
-        transfer_cell(strip.ix0 + static_cast<std::int32_t>(x), strip.iy0 + static_cast<std::int32_t>(y), fine_values_[i]);
-      }
-    }
-    transfer_.next_row += rows;
-    used += strip.width * rows;
-  }
-  if (transfer_.next_row >= r.height) {
-    if (filter_->release_anchored(transfer_.node)) ++stats_.submaps_released;
-    transfer_ = Transfer{};
-  }
-  const std::uint32_t left = map.observations_used();
-  if (left < held) observations_released_ += held - left;
-  return used > 0U ? used : 1U;
+// The permanent submap's copy into the global map (map_transfer.h), within the budget.
+std::uint32_t SdpSlam::transfer_step(std::uint32_t budget_cells) {
+  const TransferStep st = transfer_.work(budget_cells, *filter_, permanent_map_, fine_buffer());
+  stats_.map_transfer_cells += st.cells_copied;
+  stats_.map_transfer_dropped += st.cells_dropped;
+  if (st.popped) ++stats_.map_transfers_popped;
+  if (st.by_rows) ++stats_.map_transfers_by_rows;
+  if (st.released) ++stats_.submaps_released;
+  observations_released_ += st.observations_freed;
+  return st.work_cells;
 }
 
 std::uint32_t SdpSlam::release_one() {
@@ -700,138 +631,38 @@ std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
   // pool is what the bottom level's new observations come from.
   // It waits for the releases (one per call): they let prune fold the submap's lineage
   // into its node, which can then be popped.
-  if (transfer_.active && release_count_ == 0U && used < budget_cells) used += transfer_rows(budget_cells - used);
+  if (transfer_.active() && release_count_ == 0U && used < budget_cells) used += transfer_step(budget_cells - used);
   if (used >= budget_cells) return used;
   // Skeletons of the live levels, oldest first, in slices.
-  if (skeleton_job_.active) used += skeleton_work(budget_cells - used);
+  if (skeletons_.active()) used += skeleton_step(budget_cells - used);
   for (std::uint32_t lv = graph_.first_live_level(); lv < graph_.level_end() && used < budget_cells; ++lv) {
     for (std::uint32_t k = 0; k < store_.level(lv).count && used < budget_cells; ++k) {
       if (store_.submap(lv, k).skeleton_done) continue;
-      start_skeleton(lv, k);
-      used += skeleton_work(budget_cells - used);
+      skeletons_.start(store_, lv, k);
+      used += skeleton_step(budget_cells - used);
     }
   }
   return used;
 }
 
-// A submap's skeleton in slices: its patch is read from the DP map a strip of coarse
-// rows at a time (reading a cell costs microseconds: the cell's observation list is
-// searched for the submap's lineage), within the per-scan budget; the skeleton itself
-// is extracted once the whole patch is classified. One job at a time (coarse_ holds it).
+// A submap's skeleton in slices (skeleton_reader.h), one job at a time.
 std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node) {
-  if (!skeleton_job_.active || skeleton_job_.level != level || skeleton_job_.node != node) {
-    while (skeleton_job_.active) skeleton_work(0xFFFFFFFFU);
-    start_skeleton(level, node);
+  if (!skeletons_.is_job(level, node)) {
+    while (skeletons_.active()) skeleton_step(0xFFFFFFFFU);
+    skeletons_.start(store_, level, node);
   }
   std::uint32_t used = 0U;
-  while (skeleton_job_.active) used += skeleton_work(0xFFFFFFFFU);
+  while (skeletons_.active()) used += skeleton_step(0xFFFFFFFFU);
   return used;
 }
 
-void SdpSlam::start_skeleton(std::uint32_t level, std::uint32_t node) {
-  Submap& sm = store_.submap(level, node);
-  sm.point_count = 0U;
-  sm.obstacle_count = 0U;
-  box_init(sm.box);
-  CellRect r = sm.path_rect;
-  const std::uint32_t d = options_.skeleton_downsample;
-  const std::uint32_t max_fine = (coarse_side_ - 2U) * d;
-  // Bounded patch: centred crop of the padded path bounds.
-  if (r.width > max_fine) {
-    r.ix0 += static_cast<std::int32_t>((r.width - max_fine) / 2U);
-    r.width = max_fine;
+std::uint32_t SdpSlam::skeleton_step(std::uint32_t budget_cells) {
+  const SkeletonStep st = skeletons_.work(budget_cells, *filter_, store_, fine_buffer());
+  if (st.extracted) {
+    ++stats_.skeletons;
+    stats_.skeleton_truncated_points += st.truncated_points;
   }
-  if (r.height > max_fine) {
-    r.iy0 += static_cast<std::int32_t>((r.height - max_fine) / 2U);
-    r.height = max_fine;
-  }
-  skeleton_job_ = SkeletonJob{};
-  skeleton_job_.level = level;
-  skeleton_job_.node = node;
-  skeleton_job_.rect = r;
-  skeleton_job_.coarse_width = (r.width + d - 1U) / d;
-  skeleton_job_.coarse_height = (r.height + d - 1U) / d;
-  skeleton_job_.active = true;
-}
-
-std::uint32_t SdpSlam::skeleton_work(std::uint32_t budget_cells) {
-  SkeletonJob& job = skeleton_job_;
-  if (!job.active) return 0U;
-  Submap& sm = store_.submap(job.level, job.node);
-  const CellRect& r = job.rect;
-  const std::uint32_t d = options_.skeleton_downsample;
-  const std::uint32_t cw = job.coarse_width;
-  const std::uint32_t ch = job.coarse_height;
-  const DpMap& map = filter_->map();
-  std::uint32_t used = 0U;
-  if (r.width == 0U || r.height == 0U) {
-    job.next_coarse_row = ch;
-    used = 1U;
-  }
-  while (job.next_coarse_row < ch && used < budget_cells) {
-    // Whole coarse rows, as many as the budget and the fine buffer afford (at least one).
-    const std::uint32_t row_cells = r.width * d;
-    std::uint32_t rows = static_cast<std::uint32_t>(fine_cells_ / row_cells);
-    const std::uint32_t afford = (budget_cells - used) / row_cells;
-    if (rows > afford) rows = afford;
-    if (rows == 0U) rows = 1U;
-    if (rows > ch - job.next_coarse_row) rows = ch - job.next_coarse_row;
-    CellRect strip = r;
-    const std::uint32_t fy0 = job.next_coarse_row * d;
-    std::uint32_t fh = rows * d;
-    if (fy0 + fh > r.height) fh = r.height - fy0;
-    strip.iy0 = r.iy0 + static_cast<std::int32_t>(fy0);
-    strip.height = fh;
-    map.fill_rect(sm.node, strip, fine_values_, fine_known_);
-    for (std::uint32_t cy = job.next_coarse_row; cy < job.next_coarse_row + rows; ++cy) {
-      for (std::uint32_t cx = 0; cx < cw; ++cx) {
-        bool occ = false;
-        bool fre = false;
-        for (std::uint32_t dy = 0; dy < d; ++dy) {
-          const std::uint32_t y = cy * d + dy;
-          if (y >= r.height) break;
-          for (std::uint32_t dx = 0; dx < d; ++dx) {
-            const std::uint32_t x = cx * d + dx;
-            if (x >= r.width) break;
-            const std::size_t i = static_cast<std::size_t>(y - fy0) * r.width + x;
-            if (fine_known_[i] == 0U) continue;
-            const double p = filter_->occupancy(fine_values_[i]);
-            if (p >= options_.occupied_threshold) occ = true;
-            else if (p <= options_.free_threshold) fre = true;
-          }
-        }
-        coarse_[static_cast<std::size_t>(cy) * cw + cx] =
-            occ ? CellState::kOccupied : (fre ? CellState::kFree : CellState::kUnknown);
-      }
-    }
-    job.next_coarse_row += rows;
-    used += r.width * fh;
-  }
-  if (job.next_coarse_row < ch) return used;
-  // The whole patch is classified: the skeleton (and the obstacle points).
-  job.active = false;
-  sm.skeleton_done = true;
-  if (r.width == 0U || r.height == 0U) return used;
-  GridPatchView patch;
-  patch.width = cw;
-  patch.height = ch;
-  patch.resolution_m = map.resolution_m() * static_cast<double>(d);
-  patch.origin_x_m = map.options().origin_x_m + static_cast<double>(r.ix0) * map.resolution_m();
-  patch.origin_y_m = map.options().origin_y_m + static_cast<double>(r.iy0) * map.resolution_m();
-  patch.cells = coarse_;
-  SkeletonOptions so;
-  so.min_clearance_m = options_.skeleton_min_clearance_m;
-  so.max_points = options_.skeleton_points;
-  Point2* out = store_.points(job.level, job.node);
-  if (options_.loop_closure) extract_obstacles(sm, store_.obstacles(job.level, job.node), r, cw, ch);
-  const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
-  ++stats_.skeletons;
-  if (res.status == SkeletonResult::Status::kOk) {
-    sm.point_count = res.point_count;
-    stats_.skeleton_truncated_points += res.truncated_count;
-    for (std::uint32_t i = 0; i < sm.point_count; ++i) box_add(sm.box, out[i].x_m, out[i].y_m);
-  }
-  return used;
+  return st.cells_read;
 }
 
 // ---- top level (lines 10-12) -----------------------------------------------------------
@@ -928,41 +759,6 @@ void SdpSlam::update_best() {
 }
 
 // ---- loop closure (beyond the paper; see the header) ------------------------------------
-
-// Occupied coarse cells with a free 4-neighbour (wall surfaces seen from free space),
-// thinned by a fixed stride to at most loop_points, stored as the fine cell at the
-// coarse cell's centre. Reads coarse_ as extract_skeleton() just filled it.
-void SdpSlam::extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch) {
-  auto state = [&](std::uint32_t x, std::uint32_t y) { return coarse_[static_cast<std::size_t>(y) * cw + x]; };
-  auto surface = [&](std::uint32_t x, std::uint32_t y) {
-    if (state(x, y) != CellState::kOccupied) return false;
-    return (x > 0U && state(x - 1U, y) == CellState::kFree) || (x + 1U < cw && state(x + 1U, y) == CellState::kFree) ||
-           (y > 0U && state(x, y - 1U) == CellState::kFree) || (y + 1U < ch && state(x, y + 1U) == CellState::kFree);
-  };
-  std::uint32_t total = 0U;
-  for (std::uint32_t y = 0; y < ch; ++y) {
-    for (std::uint32_t x = 0; x < cw; ++x) total += surface(x, y) ? 1U : 0U;
-  }
-  const std::uint32_t k = options_.loop_points;
-  const std::uint32_t stride = total > k ? (total + k - 1U) / k : 1U;
-  const std::uint32_t d = options_.skeleton_downsample;
-  std::uint32_t seen = 0U;
-  std::uint32_t n = 0U;
-  for (std::uint32_t y = 0; y < ch && n < k; ++y) {
-    for (std::uint32_t x = 0; x < cw && n < k; ++x) {
-      if (!surface(x, y)) continue;
-      if (seen++ % stride != 0U) continue;
-      // Centre of the coarse cell in half fine cells from the map's origin.
-      const std::int64_t ix = 2 * (static_cast<std::int64_t>(r.ix0) + static_cast<std::int64_t>(x * d)) + d;
-      const std::int64_t iy = 2 * (static_cast<std::int64_t>(r.iy0) + static_cast<std::int64_t>(y * d)) + d;
-      if (ix < 0 || iy < 0 || ix > 65535 || iy > 65535) continue;
-      out[n].ix = static_cast<std::uint16_t>(ix);
-      out[n].iy = static_cast<std::uint16_t>(iy);
-      ++n;
-    }
-  }
-  sm.obstacle_count = n;
-}
 
 void SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
   const DpMap& map = filter_->map();

@@ -141,7 +141,7 @@ void SdpSlam::transfer_state(StateIo& io) {
   icp_->transfer_state(io);
   segmenter_->transfer_state(io);
   graph_.transfer_state(io);
-  skeleton_.transfer_state(io);
+  skeletons_.transfer_state(io);
   rng_.transfer_state(io);
   io.value(stats_);
   store_.transfer_state(io);
@@ -149,8 +149,7 @@ void SdpSlam::transfer_state(StateIo& io) {
   io.value(ring_count_);
   loop_closure_.transfer_state(io);
   io.value(release_count_);
-  io.value(transfer_);
-  io.value(skeleton_job_);
+  transfer_.transfer_state(io);
   permanent_map_.transfer_state(io);
   io.section("segment");
   io.value(started_);

@@ -24,8 +24,8 @@
 //
 // Top level (lines 7-12): the PGS (segment_graph.h) gets one level per segment, one node
 // per bottom particle. At anchorage every node's free-space skeleton (Fig. 2 (b)) is
-// extracted from its DP-map view around its path, in the submap frame, into fixed
-// storage (submap_store.h). T top-level particles (top_particles.h) each hold one
+// extracted from its DP-map view around its path, in the submap frame
+// (skeleton_reader.h), into fixed storage (submap_store.h). T top-level particles (top_particles.h) each hold one
 // submap choice per live level: after a segmentation they are resampled with elitism
 // and diversified from the PGS (or, with SegSLAM's topology, only over its last
 // levels), extended to the new level, and evaluated, evaluations_per_scan per call of
@@ -40,8 +40,8 @@
 // Bounded memory: when all max_levels PGS levels are live, the oldest becomes PERMANENT
 // with the best top particle's choice: that submap's poses go to the permanent path
 // sink (SdpPathSink: the poses in its frame, and that frame in the global frame), its
-// map is copied into the global map's permanent part (permanent_map.h: one grid, each
-// cell tagged with the level that put it there) and its skeleton into a ring of permanent
+// map is copied into the global map's permanent part (map_transfer.h, permanent_map.h:
+// one grid, each cell tagged with the level that put it there) and its skeleton into a ring of permanent
 // submaps (still matched for loop closures); the level's other submaps are released
 // (set_active(false) + prune frees their DP-map observations; counted), one submap per
 // call of process() so that no single scan pays for all of them. The DP map's
@@ -83,12 +83,14 @@
 #include "sdpslam/core/loops/frame_graph.h"
 #include "sdpslam/core/top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
+#include "sdpslam/core/top/map_transfer.h"
 #include "sdpslam/core/loops/loop_closure.h"
 #include "sdpslam/core/top/permanent_map.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/top/combination_evaluator.h"
 #include "sdpslam/core/top/segment_graph.h"
 #include "sdpslam/core/top/segmentation.h"
+#include "sdpslam/core/top/skeleton_reader.h"
 #include "sdpslam/core/top/submap_store.h"
 #include "sdpslam/core/top/top_particles.h"
 
@@ -283,35 +285,6 @@ class SdpSlam {
     std::int64_t stamp_us;
     Pose2 pose;
   };
-  // A skeleton being read from the DP map a strip of coarse rows at a time.
-  struct SkeletonJob {
-    bool active = false;
-    std::uint32_t level = 0U;
-    std::uint32_t node = 0U;
-    CellRect rect{};  // the patch (fine cells)
-    std::uint32_t coarse_width = 0U;
-    std::uint32_t coarse_height = 0U;
-    std::uint32_t next_coarse_row = 0U;
-  };
-  // The copy of a permanent submap into the global map node. Once the level's other
-  // submaps are released, prune has merged the submap's whole lineage into its node
-  // (every ancestor was inactive with one child), which is then a root: its
-  // observations are popped one by one (kPop: work in proportion to its known cells,
-  // and the pool refills as it goes). Otherwise the rectangle is read in strips of rows
-  // (kRows, the fallback: work in proportion to the rectangle's area).
-  enum class TransferMode : std::uint8_t { kUndecided, kPop, kRows };
-  struct Transfer {
-    bool active = false;
-    TransferMode mode = TransferMode::kUndecided;
-    NodeId node = kNoNode;
-    Pose2 frame;            // the level's frame in the global frame at the copy
-    std::uint32_t tag = 0U;  // PermanentMap tag of its cells: level + 1
-    CellRect rect{};
-    std::uint32_t next_row = 0U;
-  };
-  // Budget cells one popped observation counts for: it is a read and a global-map
-  // update, each a cell-list search, where a strip's cell is one read and mostly empty.
-  static constexpr std::uint32_t kPopCostCells = 4U;
   class RingSink final : public PoseSink {
    public:
     explicit RingSink(SdpSlam& owner) : owner_(owner) {}
@@ -321,7 +294,6 @@ class SdpSlam {
     SdpSlam& owner_;
   };
 
-  void extract_obstacles(Submap& sm, CellPoint* out, const CellRect& r, std::uint32_t cw, std::uint32_t ch);
   // Cell points → metres in the submap frame (scratch buffer).
   void unpack(const CellPoint* in, std::uint32_t n, Point2* out) const;
   std::uint16_t choice(std::uint32_t particle, std::uint32_t level) const { return top_.choice(particle, level); }
@@ -343,10 +315,9 @@ class SdpSlam {
   std::uint32_t do_work(std::uint32_t budget_cells);
   // The whole skeleton now (completing any other job first); returns cells read.
   std::uint32_t extract_skeleton(std::uint32_t level, std::uint32_t node);
-  void start_skeleton(std::uint32_t level, std::uint32_t node);
-  std::uint32_t skeleton_work(std::uint32_t budget_cells);  // the job, within the budget
-  std::uint32_t transfer_rows(std::uint32_t budget_cells);
-  void transfer_cell(std::int32_t ix, std::int32_t iy, const CellObservation& v);
+  std::uint32_t skeleton_step(std::uint32_t budget_cells);  // the job, within the budget
+  std::uint32_t transfer_step(std::uint32_t budget_cells);  // the map transfer, within the budget
+  FineBuffer fine_buffer() const { return FineBuffer{fine_values_, fine_known_, fine_cells_}; }
   std::uint32_t release_one();
   void evaluate(std::uint32_t particle);
   void end_round(std::int64_t stamp_us, bool may_continue);
@@ -389,7 +360,6 @@ class SdpSlam {
   DpSlamFilter* filter_ = nullptr;  // in the arena
   Icp2d* icp_ = nullptr;            // in the arena
   SegmentGraph graph_;
-  FreeSpaceSkeleton skeleton_;
   Segmenter* segmenter_ = nullptr;
   Rng rng_;
   RingSink ring_sink_{*this};
@@ -399,6 +369,7 @@ class SdpSlam {
 
   std::uint32_t n_bottom_ = 0U;
   SubmapStore store_;                  // live and permanent submaps
+  SkeletonReader skeletons_;           // skeletons read from the DP map at anchorage
   TopParticles top_;                   // the T combinations (lines 9-12)
   CombinationEvaluator evaluator_;     // a combination's ICP error (line 11)
   CombinationResult evaluation_{};     // scratch of evaluate()
@@ -413,8 +384,6 @@ class SdpSlam {
   CellObservation* fine_values_ = nullptr;
   std::uint8_t* fine_known_ = nullptr;
   std::size_t fine_cells_ = 0U;
-  CellState* coarse_ = nullptr;
-  std::uint32_t coarse_side_ = 0U;
   Point2* obst_a_ = nullptr;        // loop_points (scratch)
   Point2* obst_b_ = nullptr;
   LoopClosure loop_closure_;
@@ -423,8 +392,7 @@ class SdpSlam {
   // (freeing a submap's observations walks their cell lists: spread over scans).
   NodeId* release_queue_ = nullptr;  // N
   std::uint32_t release_count_ = 0U;
-  Transfer transfer_{};
-  SkeletonJob skeleton_job_{};
+  MapTransfer transfer_;  // the newest permanent submap's copy into permanent_map_
   PermanentMap permanent_map_;
 
   // Current segment.
@@ -502,14 +470,12 @@ void SdpSlam::for_each_best_pose(F&& f) const {
 template <class F>
 void SdpSlam::for_each_best_submap(F&& f) const {
   if (!initialised_ || !started_) return;
-  if (transfer_.active && store_.permanent_count() > 0U) {
-    // What the permanent map does not hold yet: a popped node keeps only the cells not
-    // copied; in strips, the rows not copied. At its level's frame now (the newest
+  NodeId copying = kNoNode;
+  CellRect rest{};
+  if (transfer_.pending(&copying, &rest) && store_.permanent_count() > 0U) {
+    // What the permanent map does not hold yet, at its level's frame now (the newest
     // permanent submap).
-    CellRect rest = transfer_.rect;
-    rest.iy0 += static_cast<std::int32_t>(transfer_.next_row);
-    rest.height -= transfer_.next_row;
-    f(transfer_.node, store_.permanent(store_.permanent_slot_at(store_.permanent_count() - 1U)).frame_in_global, rest);
+    f(copying, store_.permanent(store_.permanent_slot_at(store_.permanent_count() - 1U)).frame_in_global, rest);
   }
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
