@@ -134,7 +134,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   total += SubmapStore::required_bytes(store_options(s, b.particle_count));
   total += TopParticles::required_bytes(TopParticleOptions::from(s));
   total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
-  total += Arena::bytes_for<StampedPose>(ring_capacity_for(s)) + CombinationEvaluator::required_bytes() + Arena::bytes_for<NodeId>(n);
+  total += PoseRing::required_bytes(ring_capacity_for(s)) + CombinationEvaluator::required_bytes() + Arena::bytes_for<NodeId>(n);
   if (s.loop_closure) {
     total += LoopClosure::required_bytes(s, graph_nodes(s), search_geometry(b, s));
     total += 2U * Arena::bytes_for<Point2>(s.loop_points);
@@ -247,8 +247,10 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   frames_ = arena.allocate_array<Pose2>(L);
   eval_frames_ = arena.allocate_array<Pose2>(L);
   poses_scratch_ = arena.allocate_array<Pose2>(n_bottom_);
-  ring_capacity_ = ring_capacity_for(s);
-  ring_ = arena.allocate_array<StampedPose>(ring_capacity_);
+  if (!ring_.init(arena, ring_capacity_for(s))) {
+    std::snprintf(why_, sizeof why_, "arena exhausted while carving the pose ring");
+    return false;
+  }
   if (!evaluator_.init(CombinationOptions::from(s), icp_, arena)) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving the ICP memo");
     return false;
@@ -268,7 +270,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
   fine_known_ = arena.allocate_array<std::uint8_t>(fine_cells_);
   if (chain_ == nullptr || frames_ == nullptr ||
-      eval_frames_ == nullptr || poses_scratch_ == nullptr || ring_ == nullptr || fine_values_ == nullptr ||
+      eval_frames_ == nullptr || poses_scratch_ == nullptr || fine_values_ == nullptr ||
       fine_known_ == nullptr || release_queue_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
@@ -283,53 +285,11 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
 }
 
 void SdpSlam::ring_push(std::int64_t stamp_us, const Pose2& pose) {
-  if (ring_count_ == ring_capacity_) {
+  if (!ring_.push(stamp_us, pose)) {
     ++stats_.pose_ring_dropped;
     return;
   }
-  ring_[(ring_head_ + ring_count_) % ring_capacity_] = StampedPose{stamp_us, pose};
-  ++ring_count_;
-  if (ring_count_ > stats_.pose_ring_peak) stats_.pose_ring_peak = ring_count_;
-}
-
-CellRect SdpSlam::rect_around(double x0, double y0, double x1, double y1, double pad_m) const {
-  const DpMap& map = filter_->map();
-  CellRect r{};
-  if (!(x0 <= x1 && y0 <= y1)) return r;
-  const double res = map.resolution_m();
-  const double ox = map.options().origin_x_m;
-  const double oy = map.options().origin_y_m;
-  auto cell = [res](double v, double o) {
-    const double c = (v - o) / res;
-    return c < -1.0e9 ? -1000000000 : (c > 1.0e9 ? 1000000000 : static_cast<std::int32_t>(c >= 0.0 ? c : c - 1.0));
-  };
-  std::int32_t ix0 = cell(x0 - pad_m, ox);
-  std::int32_t iy0 = cell(y0 - pad_m, oy);
-  std::int32_t ix1 = cell(x1 + pad_m, ox) + 1;
-  std::int32_t iy1 = cell(y1 + pad_m, oy) + 1;
-  if (map.wraps()) {
-    // No edge; a segment's map lies within half the window (process()), and reading
-    // more would meet the other copies of its cells: a centred crop.
-    const auto crop = [](std::int32_t* lo, std::int32_t* hi, std::int32_t side) {
-      const std::int64_t extra = static_cast<std::int64_t>(*hi) - *lo - side / 2;
-      if (extra <= 0) return;
-      *lo = static_cast<std::int32_t>(*lo + extra / 2);
-      *hi = *lo + side / 2;
-    };
-    crop(&ix0, &ix1, map.width_cells());
-    crop(&iy0, &iy1, map.height_cells());
-  } else {
-    if (ix0 < 0) ix0 = 0;
-    if (iy0 < 0) iy0 = 0;
-    if (ix1 > map.width_cells()) ix1 = map.width_cells();
-    if (iy1 > map.height_cells()) iy1 = map.height_cells();
-  }
-  if (ix1 <= ix0 || iy1 <= iy0) return r;
-  r.ix0 = ix0;
-  r.iy0 = iy0;
-  r.width = static_cast<std::uint32_t>(ix1 - ix0);
-  r.height = static_cast<std::uint32_t>(iy1 - iy0);
-  return r;
+  if (ring_.size() > stats_.pose_ring_peak) stats_.pose_ring_peak = ring_.size();
 }
 
 void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
@@ -482,8 +442,8 @@ void SdpSlam::segment(std::int64_t stamp_us) {
     for_each_level_pose(level, nodes[i], [&b](std::int64_t, const Pose2& p) { box_add(b, p.x_m, p.y_m); });
     box_add(b, sm.final_pose.x_m, sm.final_pose.y_m);
     box_add(b, sm.initial.x_m, sm.initial.y_m);
-    sm.map_rect = rect_around(b[0], b[1], b[2], b[3], pad);
-    sm.path_rect = rect_around(b[0], b[1], b[2], b[3], options_.skeleton_pad_m);
+    sm.map_rect = filter_->map().rect_around(b[0], b[1], b[2], b[3], pad);
+    sm.path_rect = filter_->map().rect_around(b[0], b[1], b[2], b[3], options_.skeleton_pad_m);
     sm.skeleton_done = false;
   }
   ++stats_.segments;
@@ -594,11 +554,7 @@ void SdpSlam::make_oldest_permanent() {
   }
   transfer_.start(sm.node, r.frame_in_global, level + 1U, sm.map_rect);
   // Committed poses of the level leave the ring (they are the oldest).
-  const std::int64_t end = store_.level(level).end_stamp_us;
-  while (ring_count_ > 0U && ring_[ring_head_].stamp_us <= end) {
-    ring_head_ = (ring_head_ + 1U) % ring_capacity_;
-    --ring_count_;
-  }
+  ring_.drop_through(store_.level(level).end_stamp_us);
   store_.level(level).count = 0U;
 }
 

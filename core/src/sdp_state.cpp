@@ -145,8 +145,7 @@ void SdpSlam::transfer_state(StateIo& io) {
   rng_.transfer_state(io);
   io.value(stats_);
   store_.transfer_state(io);
-  io.value(ring_head_);
-  io.value(ring_count_);
+  ring_.transfer_state(io);
   loop_closure_.transfer_state(io);
   io.value(release_count_);
   transfer_.transfer_state(io);

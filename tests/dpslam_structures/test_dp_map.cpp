@@ -99,6 +99,36 @@ TEST(DpMap, world_to_cell_floors_and_rejects_outside_and_nan) {
   DOUBLES_EQUAL(3.975, y, 1e-12);
 }
 
+TEST(DpMap, rect_around_covers_a_padded_box_clipped_or_cropped) {
+  DpFixture f(8U, 8U, small_options(4U, 16U));
+  // [-0.51, 0.01] x [2.49, 3.01] grown by 0.1 m: cells 7..22 on both axes.
+  sdpslam::CellRect r = f.map.rect_around(-0.51, 2.49, 0.01, 3.01, 0.1);
+  LONGS_EQUAL(7, r.ix0);
+  LONGS_EQUAL(7, r.iy0);
+  LONGS_EQUAL(16U, r.width);
+  LONGS_EQUAL(16U, r.height);
+  // Clipped to the map without wrap.
+  r = f.map.rect_around(-2.0, 1.0, 5.0, 9.0, 0.0);
+  LONGS_EQUAL(0, r.ix0);
+  LONGS_EQUAL(0, r.iy0);
+  LONGS_EQUAL(48U, r.width);
+  LONGS_EQUAL(40U, r.height);
+  // An empty box gives an empty rectangle.
+  LONGS_EQUAL(0U, f.map.rect_around(1.0, 3.0, 0.0, 3.5, 0.1).width);
+  // With wrap: no edge, but at most half the window on each axis, about the centre.
+  DpMap::Options o = small_options(4U, 16U);
+  o.wrap = true;
+  DpFixture w(8U, 8U, o);
+  const std::int32_t half_w = w.map.width_cells() / 2;
+  const std::int32_t half_h = w.map.height_cells() / 2;
+  r = w.map.rect_around(-0.99, 2.01, 2.99, 6.01, 0.0);  // cells 0..79 on both axes
+  LONGS_EQUAL((80 - half_w) / 2, r.ix0);
+  LONGS_EQUAL(half_w, static_cast<std::int32_t>(r.width));
+  LONGS_EQUAL((80 - half_h) / 2, r.iy0);
+  LONGS_EQUAL(half_h, static_cast<std::int32_t>(r.height));
+  CHECK(half_w < 80 && half_h < 80);
+}
+
 TEST(DpMap, accumulate_adds_and_halves_both_counts_on_saturation) {
   CHECK_TRUE(obs(3, 4) == sdpslam::accumulate(obs(1, 1), 2, 3));
   const CellObservation s = sdpslam::accumulate(obs(65530, 100), 10, 1);

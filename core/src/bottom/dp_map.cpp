@@ -166,6 +166,45 @@ void DpMap::cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y
   *y_m = options_.origin_y_m + (static_cast<double>(iy) + 0.5) * options_.resolution_m;
 }
 
+CellRect DpMap::rect_around(double x0, double y0, double x1, double y1, double pad_m) const {
+  CellRect r{};
+  if (!(x0 <= x1 && y0 <= y1)) return r;
+  const double res = options_.resolution_m;
+  const double ox = options_.origin_x_m;
+  const double oy = options_.origin_y_m;
+  auto cell = [res](double v, double o) {
+    const double c = (v - o) / res;
+    return c < -1.0e9 ? -1000000000 : (c > 1.0e9 ? 1000000000 : static_cast<std::int32_t>(c >= 0.0 ? c : c - 1.0));
+  };
+  std::int32_t ix0 = cell(x0 - pad_m, ox);
+  std::int32_t iy0 = cell(y0 - pad_m, oy);
+  std::int32_t ix1 = cell(x1 + pad_m, ox) + 1;
+  std::int32_t iy1 = cell(y1 + pad_m, oy) + 1;
+  if (wrap_) {
+    // No edge; reading more than half the window would meet the other copies of its
+    // cells: a centred crop.
+    const auto crop = [](std::int32_t* lo, std::int32_t* hi, std::int32_t side) {
+      const std::int64_t extra = static_cast<std::int64_t>(*hi) - *lo - side / 2;
+      if (extra <= 0) return;
+      *lo = static_cast<std::int32_t>(*lo + extra / 2);
+      *hi = *lo + side / 2;
+    };
+    crop(&ix0, &ix1, width_cells_);
+    crop(&iy0, &iy1, height_cells_);
+  } else {
+    if (ix0 < 0) ix0 = 0;
+    if (iy0 < 0) iy0 = 0;
+    if (ix1 > width_cells_) ix1 = width_cells_;
+    if (iy1 > height_cells_) iy1 = height_cells_;
+  }
+  if (ix1 <= ix0 || iy1 <= iy0) return r;
+  r.ix0 = ix0;
+  r.iy0 = iy0;
+  r.width = static_cast<std::uint32_t>(ix1 - ix0);
+  r.height = static_cast<std::uint32_t>(iy1 - iy0);
+  return r;
+}
+
 std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_t c) const {
   std::uint32_t e = tiles_[slot].head[c];
   if (e == kNone) return kNone;

@@ -6,6 +6,8 @@
 // the displacement used by odometry deltas and by the relations metric (Kümmerle 2009).
 // Trigonometry goes through det_math.h so that results are bit-identical across
 // platforms (see there why).
+#include <cstdint>
+
 #include "sdpslam/core/det_math.h"
 
 namespace sdpslam {
@@ -42,5 +44,11 @@ struct Pose2 {
 
 // a⁻¹ ⊕ b: pose b expressed in the frame of pose a.
 inline Pose2 between(const Pose2& a, const Pose2& b) { return a.inverse().compose(b); }
+
+// A pose at an instant (microseconds on the log's or the robot's clock).
+struct StampedPose {
+  std::int64_t stamp_us = 0;
+  Pose2 pose;
+};
 
 }  // namespace sdpslam

@@ -86,6 +86,7 @@
 #include "sdpslam/core/top/map_transfer.h"
 #include "sdpslam/core/loops/loop_closure.h"
 #include "sdpslam/core/top/permanent_map.h"
+#include "sdpslam/core/pose_ring.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/top/combination_evaluator.h"
 #include "sdpslam/core/top/segment_graph.h"
@@ -254,7 +255,7 @@ class SdpSlam {
     return graph_index(level, &index);
   }
   std::uint32_t permanent_submap_count() const { return store_.permanent_count(); }
-  std::uint32_t pose_ring_capacity() const { return ring_capacity_; }
+  std::uint32_t pose_ring_capacity() const { return ring_.capacity(); }
   std::size_t arena_bytes_used() const { return arena_used_; }
   // Mean/std of the ICP error over the top-level particles that have one (0 if none).
   void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;
@@ -281,10 +282,6 @@ class SdpSlam {
   static double box_overlap_m2(const double a[4], const double b[4]);
 
  private:
-  struct StampedPose {
-    std::int64_t stamp_us;
-    Pose2 pose;
-  };
   class RingSink final : public PoseSink {
    public:
     explicit RingSink(SdpSlam& owner) : owner_(owner) {}
@@ -303,7 +300,6 @@ class SdpSlam {
   void for_each_level_pose(std::uint32_t level, NodeId leaf, F&& f) const;
   template <class F>
   void for_each_current_pose(F&& f) const;
-  CellRect rect_around(double x0, double y0, double x1, double y1, double pad_m) const;
 
   void segment(std::int64_t stamp_us);
   std::uint64_t observations_needed() const;
@@ -377,10 +373,7 @@ class SdpSlam {
   Pose2* frames_ = nullptr;            // max_levels: the best particle's chain
   Pose2* eval_frames_ = nullptr;       // max_levels: the chain being evaluated
   Pose2* poses_scratch_ = nullptr;     // N
-  StampedPose* ring_ = nullptr;
-  std::uint32_t ring_capacity_ = 0U;
-  std::uint32_t ring_head_ = 0U;
-  std::uint32_t ring_count_ = 0U;
+  PoseRing ring_;  // committed poses of the live levels and the current segment
   CellObservation* fine_values_ = nullptr;
   std::uint8_t* fine_known_ = nullptr;
   std::size_t fine_cells_ = 0U;
@@ -436,19 +429,13 @@ class SdpSlam {
 template <class F>
 void SdpSlam::for_each_level_pose(std::uint32_t level, NodeId leaf, F&& f) const {
   const SubmapLevel& lv = store_.level(level);
-  for (std::uint32_t k = 0; k < ring_count_; ++k) {
-    const StampedPose& e = ring_[(ring_head_ + k) % ring_capacity_];
-    if (e.stamp_us > lv.start_stamp_us && e.stamp_us <= lv.end_stamp_us) f(e.stamp_us, e.pose);
-  }
+  ring_.for_each_between(lv.start_stamp_us, lv.end_stamp_us, f);
   filter_->tree().for_each_pose_from_root(leaf, f);
 }
 
 template <class F>
 void SdpSlam::for_each_current_pose(F&& f) const {
-  for (std::uint32_t k = 0; k < ring_count_; ++k) {
-    const StampedPose& e = ring_[(ring_head_ + k) % ring_capacity_];
-    if (e.stamp_us > segment_start_stamp_us_) f(e.stamp_us, e.pose);
-  }
+  ring_.for_each_between(segment_start_stamp_us_, INT64_MAX, f);
   filter_->for_each_best_pose(f);
 }
 
@@ -484,7 +471,8 @@ void SdpSlam::for_each_best_submap(F&& f) const {
     f(sm.node, frames_[i], sm.map_rect);
   }
   const double pad = bottom_options_.beam.max_update_range_m;
-  f(filter_->best_node(), current_frame_, rect_around(seg_box_[0], seg_box_[1], seg_box_[2], seg_box_[3], pad));
+  f(filter_->best_node(), current_frame_,
+    filter_->map().rect_around(seg_box_[0], seg_box_[1], seg_box_[2], seg_box_[3], pad));
 }
 
 template <class F>

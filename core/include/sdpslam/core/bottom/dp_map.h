@@ -159,6 +159,10 @@ class DpMap final : public TreeListener {
   void unwrap_near(std::int32_t* ix, std::int32_t* iy, std::int32_t near_ix, std::int32_t near_iy) const;
   // World coordinates of the centre of cell (ix, iy); no bounds check.
   void cell_center(std::int32_t ix, std::int32_t iy, double* x_m, double* y_m) const;
+  // The cells covering [x0, x1] × [y0, y1] grown by pad_m on every side: clipped to the
+  // map without wrap; with wrap, cropped about its centre to half the window on each axis
+  // (more would meet the other copies of its cells). Empty (width 0) for an empty box.
+  CellRect rect_around(double x0_m, double y0_m, double x1_m, double y1_m, double pad_m) const;
 
   // ---- the particle's view -----------------------------------------------------------
   // The observation of `particle`'s deepest ancestor-or-self that has one in cell

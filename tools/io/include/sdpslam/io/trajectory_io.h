@@ -12,10 +12,7 @@
 
 namespace sdpslam::io {
 
-struct StampedPose {
-  std::int64_t stamp_us = 0;
-  Pose2 pose;
-};
+using sdpslam::StampedPose;  // core/pose2.h
 
 // Formats a microsecond stamp as seconds with exactly six decimals ("976052905.167303"),
 // exactly, without passing through floating point.

@@ -22,10 +22,7 @@
 
 namespace sdpslam::replay {
 
-struct StampedPose {
-  std::int64_t stamp_us = 0;
-  Pose2 pose;
-};
+using sdpslam::StampedPose;  // core/pose2.h
 
 // Cumulative signed wheel travel (ticks, after DiffDriveParams signs) at one instant.
 struct TickSample {
