@@ -292,6 +292,49 @@ void SdpSlam::ring_push(std::int64_t stamp_us, const Pose2& pose) {
   if (ring_.size() > stats_.pose_ring_peak) stats_.pose_ring_peak = ring_.size();
 }
 
+bool SdpSlam::global_map_grid(GlobalMapGrid* grid) const {
+  *grid = GlobalMapGrid{};
+  if (!initialised_) return false;
+  const DpMap& map = filter_->map();
+  const double res = map.resolution_m() * static_cast<double>(std::uint64_t{1} << permanent_map_.scale_log2());
+  const double fine = map.resolution_m();
+  const double ox = map.options().origin_x_m;
+  const double oy = map.options().origin_y_m;
+  // Bounds in the global frame: the permanent cells, and the live views' rectangles.
+  double gx0 = 1e300;
+  double gy0 = 1e300;
+  double gx1 = -1e300;
+  double gy1 = -1e300;
+  const auto grow = [&](double x0, double y0, double x1, double y1) {
+    gx0 = x0 < gx0 ? x0 : gx0;
+    gy0 = y0 < gy0 ? y0 : gy0;
+    gx1 = gx1 < x1 ? x1 : gx1;
+    gy1 = gy1 < y1 ? y1 : gy1;
+  };
+  const double half = 0.5 * fine;
+  for_each_permanent_cell([&](double x, double y, const CellObservation&) { grow(x - half, y - half, x + half, y + half); });
+  for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    const double xs[2] = {ox + r.ix0 * fine, ox + (r.ix0 + static_cast<double>(r.width)) * fine};
+    const double ys[2] = {oy + r.iy0 * fine, oy + (r.iy0 + static_cast<double>(r.height)) * fine};
+    for (double x : xs) {
+      for (double y : ys) {
+        double gx = 0.0;
+        double gy = 0.0;
+        frame.transform_point(x, y, gx, gy);
+        grow(gx, gy, gx, gy);
+      }
+    }
+  });
+  if (!(gx1 > gx0) || !(gy1 > gy0)) return false;
+  grid->origin_x_m = ox + std::floor((gx0 - ox) / res) * res;
+  grid->origin_y_m = oy + std::floor((gy0 - oy) / res) * res;
+  grid->resolution_m = res;
+  grid->width = static_cast<std::uint32_t>(std::ceil((gx1 - grid->origin_x_m) / res)) + 1U;
+  grid->height = static_cast<std::uint32_t>(std::ceil((gy1 - grid->origin_y_m) / res)) + 1U;
+  return true;
+}
+
 void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
   top_.error_summary(mean_m, std_m, count);
 }

@@ -870,3 +870,44 @@ TEST(SdpSlam, a_segment_ends_where_the_robot_leaves_its_square_of_the_dp_map) {
   LONGS_EQUAL(0U, r.out_of_bounds);
   LONGS_EQUAL(0U, r.stats.map_transfer_dropped);
 }
+
+TEST(SdpSlam, the_global_map_grid_is_aligned_and_holds_every_known_cell) {
+  const test::ScanSet set(2);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 13));
+  SdpSlam::GlobalMapGrid grid;
+  CHECK_FALSE(rig.slam->global_map_grid(&grid));  // nothing mapped yet
+  test::CollectPoses sink;
+  (void)run_sdp(rig, set, &sink);
+  CHECK_TRUE(rig.slam->global_map_grid(&grid));
+  CHECK(grid.width > 0U && grid.height > 0U);
+  // Aligned to the DP map's grid (at the permanent part's cell size).
+  const DpMap& map = rig.slam->bottom().map();
+  DOUBLES_EQUAL(map.resolution_m() * static_cast<double>(1U << rig.slam->permanent_map().scale_log2()),
+                grid.resolution_m, 0.0);
+  const double kx = (grid.origin_x_m - map.options().origin_x_m) / grid.resolution_m;
+  const double ky = (grid.origin_y_m - map.options().origin_y_m) / grid.resolution_m;
+  DOUBLES_EQUAL(std::round(kx), kx, 1e-6);
+  DOUBLES_EQUAL(std::round(ky), ky, 1e-6);
+  // The permanent cells first, as for_each_permanent_cell gives them, then the live
+  // views' cells; every one inside the grid.
+  std::vector<std::pair<double, double>> permanent;
+  rig.slam->for_each_permanent_cell([&](double x, double y, const CellObservation&) { permanent.push_back({x, y}); });
+  CHECK(!permanent.empty());
+  std::size_t calls = 0U;
+  std::size_t outside = 0U;
+  std::size_t permanent_in_order = 0U;
+  std::size_t unobserved = 0U;
+  rig.slam->for_each_global_cell([&](double x, double y, const CellObservation& v) {
+    if (calls < permanent.size() && permanent[calls] == std::make_pair(x, y)) ++permanent_in_order;
+    ++calls;
+    if (v.hits == 0U && v.misses == 0U) ++unobserved;
+    const double fx = (x - grid.origin_x_m) / grid.resolution_m;
+    const double fy = (y - grid.origin_y_m) / grid.resolution_m;
+    if (fx < 0.0 || fy < 0.0 || fx >= grid.width || fy >= grid.height) ++outside;
+  });
+  LONGS_EQUAL(permanent.size(), permanent_in_order);
+  CHECK(calls > permanent.size());  // the live levels add their views
+  LONGS_EQUAL(0U, outside);
+  LONGS_EQUAL(0U, unobserved);  // known cells only
+}

@@ -137,88 +137,32 @@ std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermane
 
 std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image) {
   *image = io::OccupancyImage{};
-  const DpSlamFilter& f = slam.bottom();
-  const DpMap& map = f.map();
-  // The image has the resolution the permanent part kept: the DP map's, or coarser once
-  // a full store was compacted (PermanentMap::compact), so that a large building's image
-  // stays as small as what the core holds of it. Finer cells (the live submaps) are
-  // summed into the image's.
-  const double res = map.resolution_m() * static_cast<double>(std::uint64_t{1} << slam.permanent_map().scale_log2());
-  const double fine = map.resolution_m();
-  const double ox = map.options().origin_x_m;
-  const double oy = map.options().origin_y_m;
-  // Bounds in the global frame.
-  double gx0 = 1e300, gy0 = 1e300, gx1 = -1e300, gy1 = -1e300;
-  const double half = 0.5 * fine;
-  slam.for_each_permanent_cell([&](double x, double y, const CellObservation&) {
-    gx0 = std::min(gx0, x - half);
-    gy0 = std::min(gy0, y - half);
-    gx1 = std::max(gx1, x + half);
-    gy1 = std::max(gy1, y + half);
-  });
-  slam.for_each_best_submap([&](NodeId, const Pose2& frame, const CellRect& r) {
-    if (r.width == 0U || r.height == 0U) return;
-    const double xs[2] = {ox + r.ix0 * fine, ox + (r.ix0 + static_cast<double>(r.width)) * fine};
-    const double ys[2] = {oy + r.iy0 * fine, oy + (r.iy0 + static_cast<double>(r.height)) * fine};
-    for (double x : xs) {
-      for (double y : ys) {
-        double gx = 0.0, gy = 0.0;
-        frame.transform_point(x, y, gx, gy);
-        gx0 = std::min(gx0, gx);
-        gy0 = std::min(gy0, gy);
-        gx1 = std::max(gx1, gx);
-        gy1 = std::max(gy1, gy);
-      }
-    }
-  });
-  if (!(gx1 > gx0) || !(gy1 > gy0)) return 0U;
-  // Aligned to the DP map's grid so that an identity frame maps cells exactly.
-  const double ax0 = ox + std::floor((gx0 - ox) / res) * res;
-  const double ay0 = oy + std::floor((gy0 - oy) / res) * res;
-  const auto w = static_cast<std::uint32_t>(std::ceil((gx1 - ax0) / res)) + 1U;
-  const auto h = static_cast<std::uint32_t>(std::ceil((gy1 - ay0) / res)) + 1U;
+  SdpSlam::GlobalMapGrid grid;
+  if (!slam.global_map_grid(&grid)) return 0U;
+  const std::uint32_t w = grid.width;
+  const std::uint32_t h = grid.height;
   std::vector<CellObservation> sum(static_cast<std::size_t>(w) * h);
   std::vector<std::uint8_t> any(sum.size(), 0U);
-  std::uint32_t known_cells = 0U;
-  // The permanent part, each cell moved with its level's frame (SdpSlam::for_each_permanent_cell).
-  slam.for_each_permanent_cell([&](double x, double y, const CellObservation& v) {
-    const double fx = std::floor((x - ax0) / res);
-    const double fy = std::floor((y - ay0) / res);
+  // Every known cell, the permanent ones moved with their level's frame; the cells that
+  // fall in one image cell are summed.
+  slam.for_each_global_cell([&](double x, double y, const CellObservation& v) {
+    const double fx = std::floor((x - grid.origin_x_m) / grid.resolution_m);
+    const double fy = std::floor((y - grid.origin_y_m) / grid.resolution_m);
     if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) return;
     const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
     sum[g] = accumulate(sum[g], v.hits, v.misses);
     any[g] = 1U;
   });
-  slam.for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
-    if (r.width == 0U || r.height == 0U) return;
-    std::vector<CellObservation> v(static_cast<std::size_t>(r.width) * r.height);
-    std::vector<std::uint8_t> k(v.size(), 0U);
-    map.fill_rect(node, r, v.data(), k.data());
-    for (std::uint32_t y = 0; y < r.height; ++y) {
-      for (std::uint32_t x = 0; x < r.width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * r.width + x;
-        if (k[i] == 0U) continue;
-        double cx = 0.0, cy = 0.0, gx = 0.0, gy = 0.0;
-        map.cell_center(r.ix0 + static_cast<std::int32_t>(x), r.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
-        frame.transform_point(cx, cy, gx, gy);
-        const double fx = std::floor((gx - ax0) / res);
-        const double fy = std::floor((gy - ay0) / res);
-        if (fx < 0.0 || fy < 0.0 || fx >= w || fy >= h) continue;
-        const std::size_t g = static_cast<std::size_t>(fy) * w + static_cast<std::size_t>(fx);
-        sum[g] = accumulate(sum[g], v[i].hits, v[i].misses);
-        any[g] = 1U;
-      }
-    }
-  });
   image->width = w;
   image->height = h;
-  image->resolution_m = res;
-  image->origin_x_m = ax0;
-  image->origin_y_m = ay0;
+  image->resolution_m = grid.resolution_m;
+  image->origin_x_m = grid.origin_x_m;
+  image->origin_y_m = grid.origin_y_m;
   image->occupancy.assign(sum.size(), -1.0F);
+  std::uint32_t known_cells = 0U;
   for (std::size_t i = 0; i < sum.size(); ++i) {
     if (any[i] == 0U) continue;
-    image->occupancy[i] = static_cast<float>(f.occupancy(sum[i]));
+    image->occupancy[i] = static_cast<float>(slam.occupancy(sum[i]));
     ++known_cells;
   }
   return known_cells;

@@ -232,6 +232,32 @@ class SdpSlam {
   template <class F>
   void for_each_permanent_cell(F&& f) const;
   const PermanentMap& permanent_map() const { return permanent_map_; }
+
+  // ---- the global map, rendered by the caller ------------------------------------------
+  // The grid of the best combination's global map in the global frame: aligned to the
+  // DP map's grid (an identity frame maps cells exactly), its cells as coarse as the
+  // permanent part kept them (the DP map's, or coarser once a full store was compacted:
+  // PermanentMap::compact), covering every permanent cell and every live view's
+  // rectangle. False when nothing is mapped yet.
+  struct GlobalMapGrid {
+    double origin_x_m = 0.0;  // corner of cell (0, 0)
+    double origin_y_m = 0.0;
+    double resolution_m = 0.0;
+    std::uint32_t width = 0U;
+    std::uint32_t height = 0U;
+  };
+  bool global_map_grid(GlobalMapGrid* grid) const;
+  // f(x_m, y_m, value) for every known fine cell of the global map, at its centre in the
+  // global frame: the permanent part (for_each_permanent_cell), then each view of
+  // for_each_best_submap, read from the DP map in strips of rows through the engine's
+  // work buffer. A caller sums the values of the cells that fall in one grid cell
+  // (accumulate()) and turns the sum into an occupancy (occupancy()). Call between
+  // calls of process(), never from f.
+  template <class F>
+  void for_each_global_cell(F&& f) const;
+  // The occupancy the observation model gives a cell's (hits, misses).
+  double occupancy(const CellObservation& value) const { return filter_->occupancy(value); }
+
   // Frame of the current segment in the global frame for the best top particle.
   Pose2 current_frame() const { return current_frame_; }
   std::uint32_t best_top_particle() const { return best_top_; }
@@ -504,6 +530,43 @@ void SdpSlam::for_each_permanent_cell(F&& f) const {
         double gy = 0.0;
         correction.transform_point(x, y, gx, gy);
         f(gx, gy, c.value);
+      }
+    }
+  });
+}
+
+template <class F>
+void SdpSlam::for_each_global_cell(F&& f) const {
+  if (!initialised_) return;
+  for_each_permanent_cell(f);
+  const DpMap& map = filter_->map();
+  for_each_best_submap([&](NodeId node, const Pose2& frame, const CellRect& r) {
+    if (r.width == 0U || r.height == 0U) return;
+    // Strips of whole rows that fit the work buffer (of columns too, for a rectangle
+    // wider than the buffer), row-major as the rectangle reads.
+    const std::uint32_t cols = r.width < fine_cells_ ? r.width : static_cast<std::uint32_t>(fine_cells_);
+    const std::uint32_t rows_per_strip = static_cast<std::uint32_t>(fine_cells_ / cols);
+    for (std::uint32_t y0 = 0; y0 < r.height; y0 += rows_per_strip) {
+      for (std::uint32_t x0 = 0; x0 < r.width; x0 += cols) {
+        CellRect strip = r;
+        strip.ix0 = r.ix0 + static_cast<std::int32_t>(x0);
+        strip.iy0 = r.iy0 + static_cast<std::int32_t>(y0);
+        strip.width = r.width - x0 < cols ? r.width - x0 : cols;
+        strip.height = r.height - y0 < rows_per_strip ? r.height - y0 : rows_per_strip;
+        map.fill_rect(node, strip, fine_values_, fine_known_);
+        for (std::uint32_t y = 0; y < strip.height; ++y) {
+          for (std::uint32_t x = 0; x < strip.width; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * strip.width + x;
+            if (fine_known_[i] == 0U) continue;
+            double cx = 0.0;
+            double cy = 0.0;
+            map.cell_center(strip.ix0 + static_cast<std::int32_t>(x), strip.iy0 + static_cast<std::int32_t>(y), &cx, &cy);
+            double gx = 0.0;
+            double gy = 0.0;
+            frame.transform_point(cx, cy, gx, gy);
+            f(gx, gy, fine_values_[i]);
+          }
+        }
       }
     }
   });

@@ -121,13 +121,14 @@ std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermane
 // level whose origin is no longer held has stamp "-" and zero pose.
 std::string sdp_loops_tsv(const SdpSlam& slam);
 
-// The best combination's global map (paper Fig. 3 (j)-(l)): the permanent map (each cell
-// moved with its level's frame as loop closure corrected it) plus
-// each chosen submap's DP-map view moved into the global frame (nearest cell), hits and
-// misses summed per cell; aligned to the DP map's grid, at its resolution or, once the
-// permanent map was coarsened, at the permanent map's cell size. Returns the known cells; `image`
-// stays empty (width 0) when nothing was ever written. Allocates (the image, one view at
-// a time): an output step, not a per-scan one.
+// The best combination's global map (paper Fig. 3 (j)-(l)), rendered through the core's
+// API (SdpSlam::global_map_grid, for_each_global_cell): the permanent map (each cell
+// moved with its level's frame as loop closure corrected it) plus each chosen submap's
+// DP-map view moved into the global frame (nearest cell), hits and misses summed per
+// cell; aligned to the DP map's grid, at its resolution or, once the permanent map was
+// coarsened, at the permanent map's cell size. Returns the known cells; `image` stays
+// empty (width 0) when nothing was ever written. Allocates the image: an output step,
+// not a per-scan one.
 std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* image);
 
 // The bottom filter's members of a stats.json "pools" object (ancestry nodes, path
