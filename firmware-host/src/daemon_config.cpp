@@ -5,10 +5,11 @@
 #include "sdpslam/drivers/serial_port.h"
 #include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/ini_document.h"
+#include "sdpslam/slam/option_text.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/run_sdp.h"
 
-#include <ini.h>
 #include <sys/un.h>
 
 #include <algorithm>
@@ -35,67 +36,12 @@ bool parse_mode(const char* text, SlamMode* mode) {
   return true;
 }
 
-struct ParseState {
-  DaemonConfig* config;
-  std::string file;
-  std::string error;   // the first problem found here, "file:line: reason"
-  int error_line = 0;  // its line
-  std::FILE* stream = nullptr;
-  int line = 0;
-  slam::IniDuplicates duplicates;
-  int first_sdp_line = 0;  // the first [sdp] key and the [slam] profile key, for mode dpslam's warning
-  int profile_line = 0;
-  // "section.key=value" of every key that shapes the SLAM state (DaemonConfig::slam_fingerprint).
-  std::vector<std::string> slam_keys;
-
-  void fail(const std::string& why) {
-    if (!error.empty()) return;
-    error = file + ":" + std::to_string(line) + ": " + why;
-    error_line = line;
-  }
-};
-
-// The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
 bool known_section(const std::string& sec) {
   static const char* const kOwn[] = {"can", "laser", "robot", "sync", "slam", "sdp", "localize", "output", "daemon"};
   for (const char* k : kOwn) {
     if (sec == k) return true;
   }
   return slam::is_slam_config_section(sec);
-}
-
-// The packaged inih is built without INI_HANDLER_LINENO (lines are counted here) and
-// without INI_CALL_HANDLER_ON_NEW_SECTION (section headers are checked here, so an
-// unknown section is rejected at its own line even when it holds no key).
-char* read_line(char* str, int num, void* user) {
-  auto* st = static_cast<ParseState*>(user);
-  std::string why;
-  char* r = slam::read_ini_line(st->stream, str, num, &why);
-  if (r == nullptr) return r;
-  ++st->line;
-  if (!why.empty()) {
-    st->fail(why);
-    return r;
-  }
-  const char* p = r;
-  while (*p == ' ' || *p == '\t') ++p;
-  if (*p == '[') {
-    const char* end = std::strchr(p, ']');
-    if (end != nullptr) {
-      std::string sec(p + 1, end);
-      while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
-      while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
-      if (!known_section(sec)) st->fail("unknown section [" + sec + "]");
-    }
-  }
-  if (!st->duplicates.line(r, &why)) st->fail(why);
-  return r;
-}
-
-// The first pass reads the same lines (a refused line is left to the full pass).
-char* read_line_quietly(char* str, int num, void* stream) {
-  std::string why;
-  return slam::read_ini_line(static_cast<std::FILE*>(stream), str, num, &why);
 }
 
 // Value parsers: each returns false with *why set.
@@ -133,17 +79,10 @@ bool int_in(const char* text, long long lo, long long hi, long long* out, std::s
   return true;
 }
 
+// The one boolean dialect of every INI reader (option_text.h).
 bool boolean(const char* text, bool* out, std::string* why) {
-  const std::string t(text);
-  if (t == "true" || t == "yes" || t == "1" || t == "on") {
-    *out = true;
-    return true;
-  }
-  if (t == "false" || t == "no" || t == "0" || t == "off") {
-    *out = false;
-    return true;
-  }
-  *why = "'" + t + "' is not a boolean (true/false)";
+  if (slam::parse_bool_text(text, out)) return true;
+  *why = "'" + std::string(text) + "' is not a boolean (true/false, yes/no, on/off, 1/0)";
   return false;
 }
 
@@ -191,19 +130,12 @@ R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, co
       return R::kOk;
     }
     if (key == "left_node" || key == "right_node") {
-      // CANopen node ids are 1..127 (CiA 301), ODrive axis ids 0..63 (6 bits of the 11-bit id).
-      const bool canopen = c.encoders.protocol == drivers::EncoderProtocol::kCanOpen;
-      if (!int_in(v, canopen ? 1 : 0, canopen ? 127 : 63, &i, why)) {
-        *why += canopen ? " (CANopen node id; set protocol first)" : " (ODrive axis id; set protocol first)";
-        return R::kBad;
-      }
+      // CANopen node ids are 1..127 (CiA 301), ODrive axis ids 0..63 (6 bits of the 11-bit
+      // id): the range depends on [can] protocol, so it is checked once the file is read.
+      if (!int_in(v, 0, 127, &i, why)) return R::kBad;
       const auto n = static_cast<std::uint8_t>(i);
       (key == "left_node" ? co.left_node : co.right_node) = n;
       (key == "left_node" ? od.left_node : od.right_node) = n;
-      if (co.left_node == co.right_node) {
-        *why = "left_node and right_node are the same node";
-        return R::kBad;
-      }
       return R::kOk;
     }
     if (key == "position_bytes") {
@@ -437,42 +369,6 @@ bool shapes_slam_state(const std::string& sec, const char* name) {
   return slam::is_slam_config_section(sec);
 }
 
-int handler(void* user, const char* section, const char* name, const char* value) {
-  auto* st = static_cast<ParseState*>(user);
-  const std::string sec(section);
-  std::string why;
-  if (!st->error.empty()) return 0;  // only the first problem is reported
-  if (name == nullptr) {
-    if (known_section(sec)) return 1;
-    why = "unknown section [" + sec + "]";
-  } else if (st->duplicates.key(section, name, &why)) {
-    if (sec == "sdp" && st->first_sdp_line == 0) st->first_sdp_line = st->line;
-    if (sec == "slam" && std::strcmp(name, "profile") == 0) st->profile_line = st->line;
-    const R r = handle_key(*st->config, sec, name, value, &why);
-    if (r == R::kOk) {
-      if (shapes_slam_state(sec, name)) st->slam_keys.push_back(sec + "." + name + "=" + value);
-      return 1;
-    }
-    if (r == R::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + sec + "]";
-    else if (!slam::is_slam_config_section(sec) && sec != "sdp") why = sec + "." + name + ": " + why;
-  }
-  st->fail(why);
-  return 0;
-}
-
-// First pass: [slam] mode and profile only (the last of each wins, as in the full pass;
-// malformed values are left to it), so that the profile is applied before any key.
-int profile_handler(void* user, const char* section, const char* name, const char* value) {
-  auto* c = static_cast<DaemonConfig*>(user);
-  if (name == nullptr || std::strcmp(section, "slam") != 0) return 1;
-  if (std::strcmp(name, "mode") == 0) {
-    (void)parse_mode(value, &c->mode);
-  } else if (std::strcmp(name, "profile") == 0) {
-    (void)parse_sdp_profile(value, &c->profile);
-  }
-  return 1;
-}
-
 }  // namespace
 
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
@@ -484,49 +380,90 @@ bool load_daemon_config(const std::string& path, DaemonConfig* config, std::stri
 }
 
 bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* config, std::string* error) {
+  // One INI reader for every program (slam/ini_document.h): the whole file first.
+  slam::IniDocument doc;
+  if (!doc.read(f, path, error)) return false;
   // The [slam] profile (sdp mode) is where the options start: the file's keys go on top of
-  // it wherever they appear in the file.
-  (void)ini_parse_stream(read_line_quietly, f, profile_handler, config);
+  // it wherever they appear in the file (malformed values are refused below).
+  for (const slam::IniEntry& e : doc.entries()) {
+    if (e.section != "slam") continue;
+    if (e.key == "mode") (void)parse_mode(e.value.c_str(), &config->mode);
+    if (e.key == "profile") (void)parse_sdp_profile(e.value.c_str(), &config->profile);
+  }
   if (config->mode == SlamMode::kSdp) apply_profile(config->profile, &config->slam.filter, &config->sdp);
-  std::rewind(f);
-  ParseState st{config, path, {}, 0, f, 0, {}, 0, 0, {}};
-  const int rc = ini_parse_stream(read_line, &st, handler, &st);
-  // inih's rc is the first line it could not parse or whose handler failed; a handler
-  // failure has its reason here, so an earlier rc is a malformed line.
+  // The file's first problem, in line order: an unknown section (even one without keys),
+  // a refused key, or a line refused as read.
+  int problem_line = doc.problem_line();
+  std::string problem = doc.problem();
+  for (const auto& sec : doc.sections()) {
+    if (known_section(sec.first) || (problem_line != 0 && sec.second > problem_line)) continue;
+    problem_line = sec.second;
+    problem = doc.at(sec.second, "unknown section [" + sec.first + "]");
+    break;
+  }
+  int first_sdp_line = 0;  // the first [sdp] key and the [slam] profile key, for mode dpslam's warning
+  int profile_line = 0;
+  // "section.key=value" of every key that shapes the SLAM state (DaemonConfig::slam_fingerprint).
+  std::vector<std::string> slam_keys;
+  for (const slam::IniEntry& e : doc.entries()) {
+    if (problem_line != 0 && e.line > problem_line) break;
+    std::string why;
+    const R r = handle_key(*config, e.section, e.key, e.value.c_str(), &why);
+    if (r != R::kOk) {
+      if (r == R::kUnknown) why = "unknown key '" + e.key + "' in section [" + e.section + "]";
+      else if (!slam::is_slam_config_section(e.section) && e.section != "sdp") why = e.section + "." + e.key + ": " + why;
+      problem_line = e.line;
+      problem = doc.at(e.line, why);
+      break;
+    }
+    if (e.section == "sdp" && first_sdp_line == 0) first_sdp_line = e.line;
+    if (e.section == "slam" && e.key == "profile") profile_line = e.line;
+    if (shapes_slam_state(e.section, e.key.c_str())) slam_keys.push_back(e.section + "." + e.key + "=" + e.value);
+  }
   {
     // Order-free: the same keys with the same values give the same fingerprint.
-    std::sort(st.slam_keys.begin(), st.slam_keys.end());
+    std::sort(slam_keys.begin(), slam_keys.end());
     std::string text = std::string("mode=") + to_string(config->mode) + "\nprofile=" + to_string(config->profile) + "\n";
-    for (const std::string& k : st.slam_keys) text += k + "\n";
+    for (const std::string& k : slam_keys) text += k + "\n";
     config->slam_fingerprint = io::fingerprint(text);
   }
-  if (rc > 0 && (st.error.empty() || rc < st.error_line)) {
-    *error = path + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
-    return false;
-  }
-  if (!st.error.empty()) {
-    *error = st.error;
-    return false;
-  }
-  if (rc != 0 || std::ferror(f) != 0) {
-    *error = path + ": read error";
+  if (problem_line != 0) {
+    *error = problem;
     return false;
   }
   // Keys that only sdp mode reads are not refused in mode dpslam (a file switches mode by
   // one key), but said to have no effect.
   config->warnings.clear();
   if (config->mode == SlamMode::kDpSlam) {
-    if (st.first_sdp_line > 0) {
-      config->warnings.push_back(path + ":" + std::to_string(st.first_sdp_line) +
+    if (first_sdp_line > 0) {
+      config->warnings.push_back(path + ":" + std::to_string(first_sdp_line) +
                                  ": [sdp] keys have no effect in mode dpslam");
     }
-    if (st.profile_line > 0) {
-      config->warnings.push_back(path + ":" + std::to_string(st.profile_line) +
+    if (profile_line > 0) {
+      config->warnings.push_back(path + ":" + std::to_string(profile_line) +
                                  ": slam.profile has no effect in mode dpslam");
     }
   }
-  // Checks that involve several keys, once everything is read.
+  // Checks that involve several keys, once everything is read. A refusal is named with
+  // the line of the file that set the key it names.
   const std::string at = path + ": ";
+  auto refuse = [&](const std::string& reason) {
+    const std::string located = doc.locate(reason);
+    *error = located != reason ? located : at + reason;
+    return false;
+  };
+  {
+    const bool canopen = config->encoders.protocol == drivers::EncoderProtocol::kCanOpen;
+    const drivers::CanOpenEncoderOptions& co = config->encoders.canopen;
+    for (const char* side : {"left_node", "right_node"}) {
+      const unsigned n = std::strcmp(side, "left_node") == 0 ? co.left_node : co.right_node;
+      if (canopen ? (n < 1U || n > 127U) : n > 63U) {
+        return refuse(std::string("can.") + side + ": " + std::to_string(n) +
+                      (canopen ? " out of range [1, 127] (CANopen node id)" : " out of range [0, 63] (ODrive axis id)"));
+      }
+    }
+    if (co.left_node == co.right_node) return refuse("can.right_node: left_node and right_node are the same node");
+  }
   if (config->laser_protocol == LaserProtocol::kSick && !drivers::validate(config->sick)) {
     *error = at + "laser: the LMS2xx has no variant sick_angle_deg = " + std::to_string(config->sick.angle_deg) +
              ", sick_resolution_cdeg = " + std::to_string(config->sick.resolution_cdeg);
@@ -536,12 +473,6 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
     *error = at + "robot: " + drivers::to_string(drivers::validate(config->drive));
     return false;
   }
-  // An option refused here is named with the line of the file that set it.
-  auto refuse = [&](const char* why) {
-    const std::string located = slam::locate_option_error(path, why);
-    *error = located != why ? located : at + why;
-    return false;
-  };
   char why[240];
   if (!config->slam.filter.validate(why, sizeof why)) return refuse(why);
   // Every check SDP-SLAM's init makes (SdpSlam::check_options): what is approved here starts.
@@ -553,14 +484,11 @@ bool load_daemon_config(std::FILE* f, const std::string& path, DaemonConfig* con
       *error = at + "localize.map: mode localize needs the saved map (its map.yaml)";
       return false;
     }
-    if (!config->localize.check(why, sizeof why)) return refuse((std::string("localize.") + why).c_str());
+    if (!config->localize.check(why, sizeof why)) return refuse(std::string("localize.") + why);
     // The map is read here, as at start: an unreadable map is refused before any work.
     slam::LocalizationMap map;
     std::string map_error;
-    if (!slam::load_localization_map(config->localize_map, &map, &map_error)) {
-      *error = slam::locate_option_error(path, "localize.map: " + map_error);
-      return false;
-    }
+    if (!slam::load_localization_map(config->localize_map, &map, &map_error)) return refuse("localize.map: " + map_error);
   }
   // The whole state is sized here, before any work: what is approved here can start.
   const std::size_t arena_bytes = engine_arena_bytes(*config);

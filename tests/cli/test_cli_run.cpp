@@ -302,6 +302,33 @@ TEST(CliRun, filter_particles_is_honoured_in_sdp_mode) {
   STRCMP_CONTAINS("\"bottom_particles\": 10,", slurp_without_timing(dir + "/c/stats.json").c_str());
 }
 
+// --print-config shows what the profile, the file and the flags made of the options,
+// nothing hidden: flags and profile appear in it, and it reads back as the same run's
+// configuration.
+TEST(CliRun, print_config_is_the_effective_configuration_and_reads_back) {
+  const std::string log = log_with_bad_lines(0);
+  const std::string ini = put("p.ini", "[sdp]\nmax_segment_scans = 40\nmin_segment_scans = 5\n");
+  Run r = run_cli("run " + log + " --config " + ini + " --particles 7 --topology segslam --print-config --out " + dir +
+                  "/never");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  CHECK_TEXT(access((dir + "/never").c_str(), F_OK) != 0, "--print-config ran the log");
+  STRCMP_CONTAINS("--profile accurate", r.out.c_str());
+  STRCMP_CONTAINS("\nparticles = 7 ", r.out.c_str());
+  STRCMP_CONTAINS("\ntopology = segslam ", r.out.c_str());
+  STRCMP_CONTAINS("\nmax_segment_scans = 40 ", r.out.c_str());
+  STRCMP_CONTAINS("\nkind = scan_match ", r.out.c_str());  // the profile's
+  STRCMP_CONTAINS("\nloop_search_window_m = 6 ", r.out.c_str());
+  const std::string effective = put("effective.ini", r.out);
+  Run again = run_cli("run " + log + " --config " + effective + " --print-config --out " + dir + "/never");
+  LONGS_EQUAL_TEXT(0, again.status, again.out.c_str());
+  STRCMP_EQUAL(r.out.c_str(), again.out.c_str());
+  r = run_cli("run " + log + " --mode dpslam --print-config --out " + dir + "/never");
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS("\nparticles = 30 ", r.out.c_str());
+  STRCMP_CONTAINS("\nkind = odometry ", r.out.c_str());
+  CHECK_TEXT(r.out.find("[sdp]") == std::string::npos, r.out.c_str());
+}
+
 // Top-level options given to DP-SLAM alone are refused (flags) or warned about (a
 // config's [sdp] section), never silently ignored.
 TEST(CliRun, top_level_options_in_dpslam_mode_are_not_ignored_silently) {

@@ -331,7 +331,18 @@ TEST(SdpslamdConfig, unknown_key_is_rejected_with_its_line) {
 }
 
 TEST(SdpslamdConfig, out_of_range_node_id_is_rejected) {
-  expect_rejected("[can]\nprotocol = canopen\nleft_node = 128\n", 3, "out of range [1, 127]");
+  expect_rejected("[can]\nprotocol = canopen\nleft_node = 128\n", 3, "out of range [0, 127]");
+  expect_rejected("[can]\nprotocol = canopen\nleft_node = 0\n", 3, "can.left_node: 0 out of range [1, 127]");
+  expect_rejected("[can]\nright_node = 64\nprotocol = odrive\n", 2, "can.right_node: 64 out of range [0, 63]");
+}
+
+// The node ids' range depends on the protocol: the file's order does not matter.
+TEST(SdpslamdConfig, node_ids_may_come_before_the_protocol) {
+  sdpslam::daemon::DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[can]\nleft_node = 0\nright_node = 1\nprotocol = odrive\n"), &c, &error),
+                  error.c_str());
+  LONGS_EQUAL(0, c.encoders.odrive.left_node);
 }
 
 TEST(SdpslamdConfig, same_node_for_both_wheels_is_rejected) {
@@ -442,7 +453,7 @@ TEST(SdpslamdConfig, offline_default_ini_loads_as_daemon_config_with_the_offline
 }
 
 TEST(SdpslamdConfig, malformed_sdp_value_is_rejected_with_its_line) {
-  expect_rejected("[slam]\nmode = sdp\n[sdp]\ntop_particles = ten\n", 4, "[sdp] top_particles: malformed value 'ten'");
+  expect_rejected("[slam]\nmode = sdp\n[sdp]\ntop_particles = ten\n", 4, "sdp.top_particles: 'ten' is not a non-negative 32-bit integer");
 }
 
 TEST(SdpslamdConfig, out_of_range_sdp_value_is_rejected_with_its_line) {

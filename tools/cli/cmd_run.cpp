@@ -14,6 +14,7 @@
 
 #include "cli_common.h"
 #include "sdpslam/slam/config_ini.h"
+#include "sdpslam/slam/option_text.h"
 #include "sdpslam/slam/run_offline.h"
 #include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/run_sdp.h"
@@ -44,6 +45,7 @@ struct RunArgs {
   std::string extend;
   double extend_window_m = slam::SessionContinuation::kDefaultWindowM;
   BagTopics bag;
+  bool print_config = false;
 };
 
 // What sets the options of a run, for snapshots (io/snapshot_file.h): the mode, the
@@ -160,6 +162,12 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   // Every check the core makes at init, before any work: a refusal names the key (and
   // the config's line that set it).
   if (!slam::sdp_check_options(ro, &error)) return report("", kExitUsage, slam::locate_option_error(a.config, error));
+  if (a.print_config) {
+    std::printf("; sdpslam run --mode sdp --profile %s: the effective configuration\n%s\n%s", to_string(profile),
+                slam::options_ini_text(DpSlamOptions::table(), ro.config.filter).c_str(),
+                slam::options_ini_text(SdpOptions::table(), ro.sdp).c_str());
+    return kExitOk;
+  }
   if (const int rc = check_memory_budget(a, slam::sdp_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }
@@ -215,6 +223,11 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   if (a.particles != 0U) ro.config.filter.particle_count = a.particles;
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, slam::locate_option_error(a.config, why));
+  if (a.print_config) {
+    std::printf("; sdpslam run --mode dpslam: the effective configuration\n%s",
+                slam::options_ini_text(DpSlamOptions::table(), ro.config.filter).c_str());
+    return kExitOk;
+  }
   if (const int rc = check_memory_budget(a, slam::dpslam_state_bytes(ro)); rc != kExitOk) {
     return rc;
   }
@@ -286,6 +299,8 @@ std::function<int()> setup_run(CLI::App& app) {
                  "for, at every heading (0 = take it to stand where it was left)")
       ->check(CLI::Range(0.0, 50.0));
   add_bag_options(app, &args->bag);
+  app.add_flag("--print-config", args->print_config,
+               "print the effective configuration (profile, file and flags applied, as INI) and exit");
   app.add_flag("--quiet", args->quiet, "no progress display (errors, warnings and the summary still print)");
   return [args]() -> int {
     const bool sdp = args->mode != "dpslam";

@@ -1,6 +1,6 @@
 #include "sdpslam/slam/config_ini.h"
 
-#include <ini.h>
+#include "sdpslam/slam/ini_document.h"
 
 #include <sys/stat.h>
 
@@ -13,169 +13,6 @@
 #include <string>
 
 namespace sdpslam::slam {
-namespace {
-
-struct ParseState {
-  SlamConfig* config;
-  std::string file;
-  std::string error;      // the first problem found here, "file:line: reason"
-  int error_line = 0;     // its line
-  std::FILE* stream = nullptr;
-  int line = 0;  // lines handed to inih so far = the line being handled
-  IniDuplicates duplicates;
-
-  void fail(const std::string& why) {
-    if (!error.empty()) return;
-    error = file + ":" + std::to_string(line) + ": " + why;
-    error_line = line;
-  }
-};
-
-// The packaged inih is built without INI_HANDLER_LINENO, so lines are counted here.
-char* read_line(char* str, int num, void* user) {
-  auto* st = static_cast<ParseState*>(user);
-  std::string why;
-  char* r = read_ini_line(st->stream, str, num, &why);
-  if (r == nullptr) return r;
-  ++st->line;
-  if (why.empty()) (void)st->duplicates.line(r, &why);
-  if (!why.empty()) st->fail(why);
-  return r;
-}
-
-bool parse_real(const char* text, double* out) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno == ERANGE || !std::isfinite(v)) return false;
-  *out = v;
-  return true;
-}
-
-bool parse_u32(const char* text, std::uint32_t* out) {
-  if (*text == '-' || *text == '+') return false;
-  errno = 0;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(text, &end, 10);
-  if (end == text || *end != '\0' || errno == ERANGE || v > 0xFFFFFFFFULL) return false;
-  *out = static_cast<std::uint32_t>(v);
-  return true;
-}
-
-// Nested options are addressed through small setters (member pointers cannot reach into
-// DpSlamOptions::motion / ::beam directly).
-bool set_option(DpSlamOptions& o, const std::string& section, const std::string& name, const char* value,
-                std::string* why) {
-  double r = 0.0;
-  std::uint32_t u = 0U;
-  auto real = [&](double& field) {
-    if (!parse_real(value, &r)) {
-      *why = "'" + std::string(value) + "' is not a finite number";
-      return false;
-    }
-    field = r;
-    return true;
-  };
-  auto u32 = [&](std::uint32_t& field) {
-    if (!parse_u32(value, &u)) {
-      *why = "'" + std::string(value) + "' is not a non-negative 32-bit integer";
-      return false;
-    }
-    field = u;
-    return true;
-  };
-  if (section == "filter") {
-    if (name == "particles") return u32(o.particle_count);
-    if (name == "resample_neff_ratio") return real(o.resample_neff_ratio);
-    if (name == "update_min_travel_m") return real(o.update_min_travel_m);
-    if (name == "update_min_rotation_rad") return real(o.update_min_rotation_rad);
-  } else if (section == "motion") {
-    if (name == "alpha_rot_from_rot") return real(o.motion.alpha_rot_from_rot);
-    if (name == "alpha_rot_from_trans") return real(o.motion.alpha_rot_from_trans);
-    if (name == "alpha_trans_from_trans") return real(o.motion.alpha_trans_from_trans);
-    if (name == "alpha_trans_from_rot") return real(o.motion.alpha_trans_from_rot);
-    if (name == "min_sigma_trans_m") return real(o.motion.min_sigma_trans_m);
-    if (name == "min_sigma_rot_rad") return real(o.motion.min_sigma_rot_rad);
-  } else if (section == "observation") {
-    if (name == "sigma_hit_m") return real(o.beam.sigma_hit_m);
-    if (name == "window_m") return real(o.beam.window_m);
-    if (name == "prior_hits") return real(o.beam.prior_hits);
-    if (name == "prior_misses") return real(o.beam.prior_misses);
-    if (name == "unknown_stop_probability") return real(o.beam.unknown_stop_probability);
-    if (name == "floor_likelihood") return real(o.beam.floor_likelihood);
-    if (name == "weight_beam_stride") return u32(o.beam.weight_beam_stride);
-    if (name == "max_update_range_m") return real(o.beam.max_update_range_m);
-    if (name == "no_return_free_m") return real(o.beam.no_return_free_m);
-    if (name == "likelihood_temperature") return real(o.beam.likelihood_temperature);
-  } else if (section == "proposal") {
-    if (name == "kind") {
-      if (std::strcmp(value, "odometry") == 0) {
-        o.proposal = DpSlamOptions::Proposal::kOdometry;
-      } else if (std::strcmp(value, "scan_match") == 0) {
-        o.proposal = DpSlamOptions::Proposal::kScanMatch;
-      } else {
-        *why = "'" + std::string(value) + "' is not odometry or scan_match";
-        return false;
-      }
-      return true;
-    }
-    if (name == "weight") {
-      if (std::strcmp(value, "match") == 0) {
-        o.proposal_weight = DpSlamOptions::ProposalWeight::kMatch;
-      } else if (std::strcmp(value, "neighbourhood") == 0) {
-        o.proposal_weight = DpSlamOptions::ProposalWeight::kNeighbourhood;
-      } else {
-        *why = "'" + std::string(value) + "' is not match or neighbourhood";
-        return false;
-      }
-      return true;
-    }
-    if (name == "linear_step_m") return real(o.match.linear_step_m);
-    if (name == "angular_step_rad") return real(o.match.angular_step_rad);
-    if (name == "refinements") return u32(o.match.refinements);
-    if (name == "max_iterations") return u32(o.match.max_iterations);
-    if (name == "beam_stride") return u32(o.match.beam_stride);
-    if (name == "min_beams") return u32(o.match.min_beams);
-    if (name == "min_known_fraction") return real(o.match.min_known_fraction);
-    if (name == "min_mean_log_likelihood") return real(o.match.min_mean_log_likelihood);
-    if (name == "sample_sigma_xy_m") return real(o.proposal_sigma_xy_m);
-    if (name == "sample_sigma_rot_rad") return real(o.proposal_sigma_rot_rad);
-  } else if (section == "map") {
-    if (name == "resolution_m") return real(o.map_resolution_m);
-    if (name == "width_m") return real(o.map_width_m);
-    if (name == "height_m") return real(o.map_height_m);
-    if (name == "tile_capacity") return u32(o.map_tile_capacity);
-    if (name == "observations_base") return u32(o.map_observations_base);
-    if (name == "observations_per_particle") return u32(o.map_observations_per_particle);
-  } else if (section == "capacity") {
-    if (name == "ancestry_nodes_per_particle") return u32(o.ancestry_nodes_per_particle);
-    if (name == "path_entries_per_particle") return u32(o.path_entries_per_particle);
-  }
-  *why = "unknown key '" + name + "' in section [" + section + "]";
-  return false;
-}
-
-int handler(void* user, const char* section, const char* name, const char* value) {
-  auto* st = static_cast<ParseState*>(user);
-  if (name == nullptr) return 1;  // section header alone
-  if (!st->error.empty()) return 0;
-  std::string dup;
-  if (!st->duplicates.key(section, name, &dup)) {
-    st->fail(dup);
-    return 0;
-  }
-  // [sdp] belongs to the SDP-SLAM top level; its keys are read by load_sdp_ini (run_sdp.h).
-  if (std::strcmp(section, "sdp") == 0) return 1;
-  std::string why;
-  const ConfigKeyResult r = apply_config_key(st->config, section, name, value, &why);
-  if (r == ConfigKeyResult::kApplied) return 1;
-  if (r == ConfigKeyResult::kUnknown) why = "unknown key '" + std::string(name) + "' in section [" + section + "]";
-  st->fail(why);
-  return 0;
-}
-
-}  // namespace
-
 char* read_ini_line(std::FILE* stream, char* str, int num, std::string* why) {
   const auto room = static_cast<std::size_t>(num) - 1U;  // bytes before the terminating NUL
   std::size_t len = 0;
@@ -237,7 +74,7 @@ ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, con
   if (sec == "log") {
     if (key == "max_speed_mps" || key == "max_turn_rate_radps") {
       double v = 0.0;
-      if (parse_real(value, &v) && v >= 0.0 && v <= 1000.0) {
+      if (parse_real_text(value, &v) && v >= 0.0 && v <= 1000.0) {
         (key == "max_speed_mps" ? config->log.max_speed_mps : config->log.max_turn_rate_radps) = v;
         return ConfigKeyResult::kApplied;
       }
@@ -246,27 +83,16 @@ ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, con
     }
     if (key != "default_range_max_m") return ConfigKeyResult::kUnknown;
     double r = 0.0;
-    if (parse_real(value, &r) && r > 0.0 && r <= 1000.0) {
+    if (parse_real_text(value, &r) && r > 0.0 && r <= 1000.0) {
       config->log.default_range_max_m = static_cast<float>(r);
       return ConfigKeyResult::kApplied;
     }
     *why = "log.default_range_max_m: '" + std::string(value) + "' out of range (0, 1000]";
     return ConfigKeyResult::kInvalid;
   }
-  DpSlamOptions trial = config->filter;
-  std::string reason_text;
-  if (!set_option(trial, sec, key, value, &reason_text)) {
-    if (reason_text.rfind("unknown key", 0) == 0) return ConfigKeyResult::kUnknown;
-    *why = reason_text;
-    return ConfigKeyResult::kInvalid;
-  }
-  char reason[200];
-  if (!trial.validate(reason, sizeof reason)) {
-    *why = reason;
-    return ConfigKeyResult::kInvalid;
-  }
-  config->filter = trial;
-  return ConfigKeyResult::kApplied;
+  const OptionSpec<DpSlamOptions>* row = DpSlamOptions::table().find(sec.c_str(), key.c_str());
+  if (row == nullptr) return ConfigKeyResult::kUnknown;
+  return set_option_text(*row, &config->filter, value, why) ? ConfigKeyResult::kApplied : ConfigKeyResult::kInvalid;
 }
 
 std::FILE* open_config_file(const std::string& path, std::string* error) {
@@ -289,49 +115,12 @@ std::FILE* open_config_file(const std::string& path, std::string* error) {
   return f;
 }
 
-namespace {
-
-// The line that sets [section] key, found by inih as every reader here parses (0: none).
-struct KeyLine {
-  std::FILE* stream = nullptr;
-  std::string section;
-  std::string key;
-  int line = 0;
-  int found = 0;
-};
-
-char* key_line_read(char* str, int num, void* user) {
-  auto* k = static_cast<KeyLine*>(user);
-  std::string ignored;
-  char* r = read_ini_line(k->stream, str, num, &ignored);
-  if (r != nullptr) ++k->line;
-  return r;
-}
-
-int key_line_handler(void* user, const char* section, const char* name, const char*) {
-  auto* k = static_cast<KeyLine*>(user);
-  if (k->found == 0 && name != nullptr && k->section == section && k->key == name) k->found = k->line;
-  return 1;
-}
-
-}  // namespace
-
 std::string locate_option_error(const std::string& path, const std::string& why) {
-  const std::size_t dot = why.find('.');
-  const std::size_t colon = why.find(':');
-  if (path.empty() || dot == std::string::npos || colon == std::string::npos || dot > colon) return why;
-  std::size_t end = dot + 1U;
-  while (end < colon && (std::isalnum(static_cast<unsigned char>(why[end])) != 0 || why[end] == '_')) ++end;
-  KeyLine k;
-  k.section = why.substr(0, dot);
-  k.key = why.substr(dot + 1U, end - dot - 1U);
-  if (k.key.empty()) return why;
+  if (path.empty()) return why;
+  IniDocument doc;
   std::string ignored;
-  k.stream = open_config_file(path, &ignored);
-  if (k.stream == nullptr) return why;
-  (void)ini_parse_stream(key_line_read, &k, key_line_handler, &k);
-  std::fclose(k.stream);
-  return k.found == 0 ? why : path + ":" + std::to_string(k.found) + ": " + why;
+  if (!doc.load(path, &ignored)) return why;
+  return doc.locate(why);
 }
 
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error) {
@@ -347,19 +136,22 @@ bool load_config_ini(const std::string& path, SlamConfig* config, std::string* e
 }
 
 bool load_config_ini(std::FILE* stream, const std::string& name, SlamConfig* config, std::string* error) {
-  ParseState st{config, name, {}, 0, stream, 0, {}};
-  const int rc = ini_parse_stream(read_line, &st, handler, &st);
-  // inih's rc is the first line it could not parse or whose handler failed; a handler
-  // failure has its reason here, so an earlier rc is a malformed line.
+  IniDocument doc;
   std::string why;
-  if (rc > 0 && (st.error.empty() || rc < st.error_line)) {
-    why = name + ":" + std::to_string(rc) + ": malformed line (expected [section] or key = value)";
-  } else if (!st.error.empty()) {
-    why = st.error;
-  } else if (rc != 0 || std::ferror(stream) != 0) {
-    why = name + ": read error";
+  if (!doc.read(stream, name, &why)) {
+    if (error != nullptr) *error = why;
+    return false;
   }
-  if (why.empty()) return true;
+  // [sdp] is the top level's (load_sdp_ini).
+  auto apply = [](const IniEntry& e, SlamConfig* c, std::string* reason) {
+    if (e.section == "sdp") return EntryResult::kSkipped;
+    const ConfigKeyResult r = apply_config_key(c, e.section, e.key, e.value.c_str(), reason);
+    if (r == ConfigKeyResult::kApplied) return EntryResult::kApplied;
+    if (r == ConfigKeyResult::kUnknown) *reason = "unknown key '" + e.key + "' in section [" + e.section + "]";
+    return EntryResult::kRefused;
+  };
+  auto valid = [](const SlamConfig& c, char* reason, std::size_t n) { return c.filter.validate(reason, n); };
+  if (apply_ini_document(doc, config, apply, valid, &why)) return true;
   if (error != nullptr) *error = why;
   return false;
 }

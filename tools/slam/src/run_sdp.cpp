@@ -1,6 +1,5 @@
 #include "sdpslam/slam/run_sdp.h"
 
-#include <ini.h>
 #include <sys/resource.h>
 #include <time.h>
 
@@ -21,69 +20,13 @@
 #include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
+#include "sdpslam/slam/ini_document.h"
 #include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
 
 namespace sdpslam::slam {
 namespace {
-
-// ---- [sdp] keys ---------------------------------------------------------------------
-
-bool parse_double(const char* v, double* out) {
-  char* end = nullptr;
-  errno = 0;
-  const double d = std::strtod(v, &end);
-  if (end == v || errno != 0 || !std::isfinite(d)) return false;
-  while (*end == ' ' || *end == '\t') ++end;
-  if (*end != '\0') return false;
-  *out = d;
-  return true;
-}
-bool parse_u32(const char* v, std::uint32_t* out) {
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long u = std::strtoull(v, &end, 10);
-  if (end == v || errno != 0 || u > 0xFFFFFFFFULL || v[0] == '-') return false;
-  while (*end == ' ' || *end == '\t') ++end;
-  if (*end != '\0') return false;
-  *out = static_cast<std::uint32_t>(u);
-  return true;
-}
-
-struct IniState {
-  SdpOptions* options;
-  std::FILE* stream;
-  int line = 0;        // lines handed to inih so far = the line being handled
-  int error_line = 0;  // the first line refused here, with its reason
-  std::string why;
-
-  void fail(const std::string& reason) {
-    if (error_line != 0) return;
-    error_line = line;
-    why = reason;
-  }
-};
-
-char* sdp_read_line(char* str, int num, void* user) {
-  auto* st = static_cast<IniState*>(user);
-  std::string why;
-  char* r = read_ini_line(st->stream, str, num, &why);
-  if (r == nullptr) return r;
-  ++st->line;
-  if (!why.empty()) st->fail(why);
-  return r;
-}
-
-int sdp_handler(void* user, const char* section, const char* name, const char* value) {
-  auto* st = static_cast<IniState*>(user);
-  if (std::strcmp(section, "sdp") != 0) return 1;
-  std::string why;
-  const SdpKeyResult r = apply_sdp_key(st->options, name, value, &why);
-  if (r == SdpKeyResult::kApplied) return 1;
-  st->fail(r == SdpKeyResult::kUnknown ? std::string("unknown key [sdp] ") + name : why);
-  return 0;
-}
 
 // ---- outputs ------------------------------------------------------------------------
 
@@ -131,119 +74,12 @@ io::Chart error_chart(const std::vector<Row>& rows, std::int64_t t0_us) {
 }  // namespace
 
 SdpKeyResult apply_sdp_key(SdpOptions* o, const std::string& key, const char* value, std::string* why) {
-  SdpOptions t = *o;
-  double d = 0.0;
-  std::uint32_t u = 0U;
-  auto real = [&](double* field) {
-    if (!parse_double(value, &d)) return false;
-    *field = d;
-    return true;
-  };
-  auto integer = [&](std::uint32_t* field) {
-    if (!parse_u32(value, &u)) return false;
-    *field = u;
-    return true;
-  };
-  bool ok = true;
-  const std::string v = value;
-  if (key == "top_particles") ok = integer(&t.top_particles);
-  else if (key == "topology") {
-    if (v == "sdp") t.topology = TopologyMode::kSdp;
-    else if (v == "segslam") t.topology = TopologyMode::kSegSlam;
-    else ok = false;
-  } else if (key == "segslam_window") ok = integer(&t.segslam_window);
-  else if (key == "elite_fraction") ok = real(&t.elite_fraction);
-  else if (key == "worst_fraction") ok = real(&t.worst_fraction);
-  else if (key == "diversify_levels") ok = integer(&t.diversify_levels);
-  else if (key == "follow_best_fraction") ok = real(&t.follow_best_fraction);
-  else if (key == "rounds_per_segment") ok = integer(&t.rounds_per_segment);
-  else if (key == "evaluations_per_scan") ok = integer(&t.evaluations_per_scan);
-  else if (key == "max_pairs_per_sample") ok = integer(&t.max_pairs_per_sample);
-  else if (key == "overlap_margin_m") ok = real(&t.overlap_margin_m);
-  else if (key == "min_overlap_m2") ok = real(&t.min_overlap_m2);
-  else if (key == "segmentation") {
-    if (v == "periodic") t.segmentation = SegmentationMode::kPeriodic;
-    else if (v == "dispersion") t.segmentation = SegmentationMode::kDispersion;
-    else ok = false;
-  } else if (key == "period_travel_m") ok = real(&t.period_travel_m);
-  else if (key == "period_time_s") ok = real(&t.period_time_s);
-  else if (key == "period_scans") ok = integer(&t.period_scans);
-  else if (key == "dispersion_threshold_m") ok = real(&t.dispersion_threshold_m);
-  else if (key == "min_segment_scans") ok = integer(&t.min_segment_scans);
-  else if (key == "max_segment_scans") ok = integer(&t.max_segment_scans);
-  else if (key == "max_levels") ok = integer(&t.max_levels);
-  else if (key == "accumulation") {
-    if (v == "sum") t.accumulation = PgsAccumulation::kSum;
-    else if (v == "mean") t.accumulation = PgsAccumulation::kMean;
-    else ok = false;
-  } else if (key == "prior_error_m") ok = real(&t.prior_error_m);
-  else if (key == "max_permanent_submaps") ok = integer(&t.max_permanent_submaps);
-  else if (key == "skeleton_points") ok = integer(&t.skeleton_points);
-  else if (key == "skeleton_downsample") ok = integer(&t.skeleton_downsample);
-  else if (key == "skeleton_pad_m") ok = real(&t.skeleton_pad_m);
-  else if (key == "skeleton_max_side_m") ok = real(&t.skeleton_max_side_m);
-  else if (key == "skeleton_min_clearance_m") ok = real(&t.skeleton_min_clearance_m);
-  else if (key == "occupied_threshold") ok = real(&t.occupied_threshold);
-  else if (key == "free_threshold") ok = real(&t.free_threshold);
-  else if (key == "work_cells_per_scan") ok = integer(&t.work_cells_per_scan);
-  else if (key == "defer_top_work") {
-    if (v == "true") t.defer_top_work = true;
-    else if (v == "false") t.defer_top_work = false;
-    else ok = false;
-  }
-  else if (key == "map_tile_capacity") ok = integer(&t.map_tile_capacity);
-  else if (key == "map_observation_capacity") ok = integer(&t.map_observation_capacity);
-  else if (key == "permanent_map_tiles") ok = integer(&t.permanent_map_tiles);
-  else if (key == "map_owner_cell_index") {
-    if (v == "true") t.map_owner_cell_index = true;
-    else if (v == "false") t.map_owner_cell_index = false;
-    else ok = false;
-  }
-  else if (key == "icp_max_iterations") ok = integer(&t.icp.max_iterations);
-  else if (key == "icp_max_correspondence_m") ok = real(&t.icp.max_correspondence_m);
-  else if (key == "icp_nn_cell_m") ok = real(&t.icp.nn_cell_m);
-  else if (key == "icp_min_pairs") ok = integer(&t.icp.min_pairs);
-  else if (key == "icp_correction_weight") ok = real(&t.icp_correction_weight);
-  else if (key == "icp_correction_lever_m") ok = real(&t.icp_correction_lever_m);
-  else if (key == "loop_closure") {
-    if (v == "true") t.loop_closure = true;
-    else if (v == "false") t.loop_closure = false;
-    else ok = false;
-  }
-  else if (key == "loop_points") ok = integer(&t.loop_points);
-  else if (key == "loop_icp_max_correspondence_m") ok = real(&t.loop_icp_max_correspondence_m);
-  else if (key == "loop_max_error_m") ok = real(&t.loop_max_error_m);
-  else if (key == "loop_min_pairs") ok = integer(&t.loop_min_pairs);
-  else if (key == "loop_max_correction_m") ok = real(&t.loop_max_correction_m);
-  else if (key == "segment_sigma_xy_m") ok = real(&t.segment_sigma_xy_m);
-  else if (key == "segment_sigma_theta_rad") ok = real(&t.segment_sigma_theta_rad);
-  else if (key == "loop_sigma_xy_m") ok = real(&t.loop_sigma_xy_m);
-  else if (key == "loop_sigma_theta_rad") ok = real(&t.loop_sigma_theta_rad);
-  else if (key == "loop_normal_radius_m") ok = real(&t.loop_normal_radius_m);
-  else if (key == "loop_weak_direction_floor") ok = real(&t.loop_weak_direction_floor);
-  else if (key == "loop_robust_chi") ok = real(&t.loop_robust_chi);
-  else if (key == "max_loop_constraints") ok = integer(&t.max_loop_constraints);
-  else if (key == "graph_iterations") ok = integer(&t.graph_iterations);
-  else if (key == "loop_search_window_m") ok = real(&t.loop_search_window_m);
-  else if (key == "loop_search_max_window_m") ok = real(&t.loop_search_max_window_m);
-  else if (key == "loop_search_window_rad") ok = real(&t.loop_search_window_rad);
-  else if (key == "loop_search_min_score") ok = real(&t.loop_search_min_score);
-  else if (key == "loop_search_max_ambiguity") ok = real(&t.loop_search_max_ambiguity);
-  else if (key == "loop_search_drift_m") ok = real(&t.loop_search_drift_m);
-  else if (key == "loop_search_candidates") ok = integer(&t.loop_search_candidates);
-  else if (key == "loop_search_reads_per_scan") ok = integer(&t.loop_search_reads_per_scan);
-  else return SdpKeyResult::kUnknown;
-  if (!ok) {
-    if (why != nullptr) *why = "[sdp] " + key + ": malformed value '" + v + "'";
-    return SdpKeyResult::kInvalid;
-  }
-  char buf[200];
-  if (!t.validate(buf, sizeof buf)) {
-    if (why != nullptr) *why = buf;
-    return SdpKeyResult::kInvalid;
-  }
-  *o = t;
-  return SdpKeyResult::kApplied;
+  const OptionSpec<SdpOptions>* row = SdpOptions::table().find("sdp", key.c_str());
+  if (row == nullptr) return SdpKeyResult::kUnknown;
+  std::string reason;
+  if (set_option_text(*row, o, value, &reason)) return SdpKeyResult::kApplied;
+  if (why != nullptr) *why = reason;
+  return SdpKeyResult::kInvalid;
 }
 
 bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error) {
@@ -255,20 +91,8 @@ bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* err
 }
 
 bool load_sdp_ini(std::FILE* stream, const std::string& name, SdpOptions* options, std::string* error) {
-  IniState st{options, stream, 0, 0, {}};
-  const int rc = ini_parse_stream(sdp_read_line, &st, sdp_handler, &st);
-  // inih's rc is the first line it could not parse or whose handler failed; a handler
-  // failure has its reason here, so an earlier rc is a malformed line.
-  if (rc > 0 && (st.error_line == 0 || rc < st.error_line)) {
-    *error = name + ":" + std::to_string(rc) + ": malformed line";
-  } else if (st.error_line != 0) {
-    *error = name + ":" + std::to_string(st.error_line) + ": " + st.why;
-  } else if (rc != 0 || std::ferror(stream) != 0) {
-    *error = name + ": read error";
-  } else {
-    return true;
-  }
-  return false;
+  IniDocument doc;
+  return doc.read(stream, name, error) && apply_ini_table(doc, SdpOptions::table(), options, error);
 }
 
 std::size_t sdp_state_bytes(const SdpRunOptions& options) {

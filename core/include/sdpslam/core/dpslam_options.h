@@ -7,6 +7,7 @@
 
 #include "sdpslam/core/bottom/beam_model.h"
 #include "sdpslam/core/capacities.h"
+#include "sdpslam/core/option_table.h"
 #include "sdpslam/core/bottom/motion_model.h"
 #include "sdpslam/core/bottom/scan_matcher.h"
 
@@ -68,6 +69,11 @@ struct DpSlamOptions {
 
   // True iff every field is in range; otherwise writes "field: value out of range
   // [lo, hi]" (truncated to n bytes, NUL-terminated) into `why` (may be null).
+  // Every key of the [filter] [motion] [observation] [proposal] [map] [capacity]
+  // sections: its field, range, unit and doc.
+  static OptionTable<DpSlamOptions> table();
+  // True iff every field is in its table's range and the fields agree; otherwise writes
+  // "section.key: ..." into `why` (may be null).
   bool validate(char* why, std::size_t n) const;
 
   // Derived capacities (valid options only).

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/capacities.h"
+#include "sdpslam/core/option_table.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/top/segment_graph.h"
 
@@ -202,8 +203,10 @@ struct SdpOptions {
     icp.min_pairs = 20U;
   }
 
-  // True iff every field is in range; otherwise writes "sdp.field: value out of range
-  // [lo, hi]" into `why` (may be null).
+  // Every key of the [sdp] section: its field, range, unit and doc.
+  static OptionTable<SdpOptions> table();
+  // True iff every field is in its table's range and the fields agree; otherwise writes
+  // "sdp.field: ..." into `why` (may be null).
   bool validate(char* why, std::size_t n) const;
 };
 

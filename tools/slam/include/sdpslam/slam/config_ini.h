@@ -17,12 +17,13 @@ struct SlamConfig {
   io::LogReaderOptions log;
 };
 
-// Applies the keys of `path` on top of *config (keys not in the file keep their value).
-// False iff the file cannot be read, a line is malformed (longer than 198 characters and
-// holding a control byte included: read_ini_line), a section/key is unknown, a value is not a
-// finite number of the right kind, or a value makes the options invalid; `error` is then
-// "file:line: reason" of the first such line; also iff a section or a key is given twice
-// (IniDuplicates), [sdp] included. An [sdp] section (SDP-SLAM's top level, read by
+// Applies the keys of `path` on top of *config (keys not in the file keep their value),
+// through DpSlamOptions::table(), then validates the options once, whatever the order of
+// the keys. False iff the file cannot be read (IniDocument: a malformed line, a line too
+// long or holding a control byte, a section or a key given twice, [sdp] included), a
+// section/key is unknown, a value is not of its key's kind or outside its range, or the
+// options as a whole are invalid; `error` is then "file:line: reason" of the line to
+// change, and *config is unchanged. An [sdp] section (SDP-SLAM's top level, read by
 // load_sdp_ini in run_sdp.h) is skipped.
 bool load_config_ini(const std::string& path, SlamConfig* config, std::string* error);
 // The same from an open stream (read to its end, not closed); `name` stands for the file
@@ -71,9 +72,10 @@ class IniDuplicates {
 
 // One `key = value` of the sections above ([filter] [motion] [observation] [map]
 // [capacity] [log]), for programs whose own INI files embed these sections (sdpslamd).
-// kApplied: *config changed and is still valid; kUnknown: not a key of these sections
-// (*config untouched); kInvalid: a key of these sections whose value is malformed or makes
-// the options invalid (*config untouched, *why says why, without file:line).
+// kApplied: *config changed; kUnknown: not a key of these sections (*config untouched);
+// kInvalid: a key of these sections whose value is malformed or outside the key's range
+// (*config untouched, *why says why, without file:line). The checks that join keys
+// (DpSlamOptions::validate) are the caller's, once every key is applied.
 enum class ConfigKeyResult { kApplied, kUnknown, kInvalid };
 ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& section, const std::string& key,
                                  const char* value, std::string* why);

@@ -96,14 +96,16 @@ bool sdp_check_options(const SdpRunOptions& options, std::string* why);
 SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& options, const std::string& out_dir,
                              SdpRunSummary* summary, std::string* error);
 
-// Applies `[sdp] key = value` to *options. kApplied / kUnknown (not an sdp key) /
-// kInvalid (malformed value or out of range; *why says why).
+// Applies `[sdp] key = value` to *options through SdpOptions::table() (option_text.h).
+// kApplied / kUnknown (not an sdp key) / kInvalid (malformed value or outside the key's
+// own range; *why says why). The checks that join keys are SdpOptions::validate(), for
+// the caller to run once every key is applied.
 enum class SdpKeyResult { kApplied, kUnknown, kInvalid };
 SdpKeyResult apply_sdp_key(SdpOptions* options, const std::string& key, const char* value, std::string* why);
-// Reads only the [sdp] section of an INI file (the keys of other sections are ignored).
-// False iff the file cannot be read, a line is malformed (read_ini_line in config_ini.h
-// included) or an [sdp] key is unknown or its value malformed / out of range; `error` is
-// then "file:line: why" of the first such line.
+// Reads only the [sdp] section of an INI file (the keys of other sections are ignored),
+// then validates the options once. False iff the file cannot be read (IniDocument), an
+// [sdp] key is unknown or its value malformed or outside its range, or the options as a
+// whole are invalid; `error` is then "file:line: why" of the line to change.
 bool load_sdp_ini(const std::string& path, SdpOptions* options, std::string* error);
 // The same from an open stream (read to its end, not closed); `name` stands for the file
 // in messages.
