@@ -119,6 +119,21 @@ TEST(SdpConfig, every_row_refuses_values_outside_its_range_by_name) {
   check_rows_refuse_values_outside_their_range(DpSlamOptions::table());
 }
 
+// tools/slam/scan_match.ini (mode dpslam with the improved proposal) sets what the
+// accurate profile sets on the bottom level, and nothing else.
+TEST(SdpConfig, scan_match_ini_is_the_accurate_profile_s_bottom_level) {
+  slam::SlamConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_SCAN_MATCH_INI, &c, &error), error.c_str());
+  DpSlamOptions accurate;
+  SdpOptions ignored;
+  apply_profile(SdpProfile::kAccurate, &accurate, &ignored);
+  accurate.particle_count = DpSlamOptions{}.particle_count;  // the mode's, not the file's
+  for (const OptionSpec<DpSlamOptions>& row : DpSlamOptions::table()) {
+    STRCMP_EQUAL_TEXT(slam::option_text(row, accurate).c_str(), slam::option_text(row, c.filter).c_str(), row.key);
+  }
+}
+
 // A file means the same whatever the order of its keys: checks that join keys run once,
 // after the last one, and name the line of the first key they join.
 TEST(SdpConfig, keys_are_validated_together_after_the_whole_file) {
