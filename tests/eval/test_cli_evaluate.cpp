@@ -251,6 +251,9 @@ TEST(CliEvaluate, loop_constraints_are_checked_against_the_ground_truth) {
   STRCMP_CONTAINS("search      1: right 1, between 0, wrong 0", r.out.c_str());
   STRCMP_CONTAINS("icp         1: right 0, between 0, wrong 1, largest error 3.000 m", r.out.c_str());
   STRCMP_CONTAINS("used        2: right 1, between 0, wrong 1", r.out.c_str());
+  // ... and the wrong one is named, so that a run can be looked into where it went wrong.
+  STRCMP_CONTAINS("wrong       levels 0-3 (icp, used, stamps 1.0 s and 4.0 s): 3.000 m, 0.00 deg off", r.out.c_str());
+  CHECK_TEXT(r.out.find("levels 0-3 (search") == std::string::npos, r.out.c_str());
   const nlohmann::json json = json_of(dir + "/out.json")["loops"];
   STRCMP_EQUAL(loops.c_str(), json["file"].get<std::string>().c_str());
   const nlohmann::json icp = json["icp"];

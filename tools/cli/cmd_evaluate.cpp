@@ -301,6 +301,23 @@ int run_loops(const EvaluateArgs& a, io::Json* json) {
   row("search", r.search);
   row("icp", r.icp);
   row("used", r.used);
+  // The wrong ones by name, worst first, so that a run can be looked into where it went
+  // wrong (levels and stamps as in loops.tsv).
+  std::vector<std::size_t> wrong;
+  for (std::size_t i = 0; i < r.checks.size() && i < lines.size(); ++i) {
+    if (r.checks[i].matched && r.checks[i].error_m >= eval::kLoopWrongM) wrong.push_back(i);
+  }
+  std::stable_sort(wrong.begin(), wrong.end(),
+                   [&r](std::size_t x, std::size_t y) { return r.checks[x].error_m > r.checks[y].error_m; });
+  constexpr std::size_t kWrongShown = 20U;
+  for (std::size_t k = 0; k < wrong.size() && k < kWrongShown; ++k) {
+    const eval::LoopLine& l = lines[wrong[k]];
+    std::printf("  wrong       levels %u-%u (%s%s, stamps %.1f s and %.1f s): %.3f m, %.2f deg off\n", l.older_level,
+                l.newer_level, l.searched ? "search" : "icp", l.used ? ", used" : "",
+                static_cast<double>(l.older_stamp_us) * 1e-6, static_cast<double>(l.newer_stamp_us) * 1e-6,
+                r.checks[wrong[k]].error_m, r.checks[wrong[k]].heading_error_rad * 180.0 / 3.14159265358979323846);
+  }
+  if (wrong.size() > kWrongShown) std::printf("  wrong       ... and %zu more\n", wrong.size() - kWrongShown);
   (*json)["loops"] = {{"file", a.loops_path},
                       {"count", r.count},
                       {"unmatched", r.unmatched},
