@@ -88,275 +88,379 @@ bool boolean(const char* text, bool* out, std::string* why) {
 
 enum class R { kOk, kUnknown, kBad };
 
-R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, const char* v, std::string* why) {
+// ---- the daemon's own keys ------------------------------------------------------------
+// Setters for the rows below: each returns false with *why set (without "section.key: ").
+
+bool set_real(double* field, const char* v, double lo, double hi, bool lo_open, std::string* why) {
   double d = 0.0;
+  if (!real_in(v, lo, hi, lo_open, &d, why)) return false;
+  *field = d;
+  return true;
+}
+// A duration given in ms (or s: `scale_us`), kept in µs.
+bool set_us(std::int64_t* field, const char* v, double lo, double hi, double scale_us, std::string* why) {
+  double d = 0.0;
+  if (!real_in(v, lo, hi, false, &d, why)) return false;
+  *field = static_cast<std::int64_t>(std::llround(d * scale_us));
+  return true;
+}
+template <class T>
+bool set_int(T* field, const char* v, long long lo, long long hi, std::string* why) {
   long long i = 0;
-  auto ok = [](bool b) { return b ? R::kOk : R::kBad; };
-  auto ms = [&](std::int64_t& field, double lo, double hi, bool lo_open) {
-    if (!real_in(v, lo, hi, lo_open, &d, why)) return R::kBad;
-    field = static_cast<std::int64_t>(std::llround(d * 1000.0));
-    return R::kOk;
-  };
-  auto real = [&](double& field, double lo, double hi, bool lo_open) {
-    if (!real_in(v, lo, hi, lo_open, &d, why)) return R::kBad;
-    field = d;
-    return R::kOk;
-  };
-  auto path = [&](std::string& field, const char* what) {
-    if (*v == '\0') {
-      *why = std::string("empty ") + what;
-      return R::kBad;
-    }
-    field = v;
-    return R::kOk;
-  };
-  if (sec == "can") {
-    drivers::CanOpenEncoderOptions& co = c.encoders.canopen;
-    drivers::ODriveEncoderOptions& od = c.encoders.odrive;
-    if (key == "interface") {
-      const std::size_t n = std::strlen(v);
-      if (n == 0U || n > 15U || std::strchr(v, '/') != nullptr || std::strchr(v, ' ') != nullptr) {
-        *why = "interface name must be 1..15 characters without '/' or spaces";
-        return R::kBad;
-      }
-      c.can_interface = v;
-      return R::kOk;
-    }
-    if (key == "protocol") {
-      if (!drivers::parse_encoder_protocol(v, c.encoders.protocol)) {
-        *why = "'" + std::string(v) + "' is not an encoder protocol (canopen, odrive)";
-        return R::kBad;
-      }
-      return R::kOk;
-    }
-    if (key == "left_node" || key == "right_node") {
-      // CANopen node ids are 1..127 (CiA 301), ODrive axis ids 0..63 (6 bits of the 11-bit
-      // id): the range depends on [can] protocol, so it is checked once the file is read.
-      if (!int_in(v, 0, 127, &i, why)) return R::kBad;
-      const auto n = static_cast<std::uint8_t>(i);
-      (key == "left_node" ? co.left_node : co.right_node) = n;
-      (key == "left_node" ? od.left_node : od.right_node) = n;
-      return R::kOk;
-    }
-    if (key == "position_bytes") {
-      if (!int_in(v, 2, 4, &i, why) || i == 3) {
-        *why = std::string(v) + ": position_bytes must be 2 or 4";
-        return R::kBad;
-      }
-      co.position_bytes = static_cast<std::uint8_t>(i);
-      return R::kOk;
-    }
-    if (key == "send_nmt_start") return ok(boolean(v, &co.send_nmt_start, why));
-    if (key == "sync_period_ms") return ms(co.sync_period_us, 0.0, 1000.0, false);
-    if (key == "position_timeout_ms") {
-      const R r = ms(co.position_timeout_us, 1.0, 10000.0, false);
-      od.position_timeout_us = co.position_timeout_us;
-      return r;
-    }
-    if (key == "heartbeat_timeout_ms") {
-      const R r = ms(co.heartbeat_timeout_us, 0.0, 60000.0, false);
-      od.heartbeat_timeout_us = co.heartbeat_timeout_us;
-      return r;
-    }
-    if (key == "odrive_counts_per_turn") return real(od.counts_per_turn, 1.0, 1e7, false);
-    if (key == "odrive_request_period_ms") return ms(od.request_period_us, 0.0, 1000.0, false);
-    if (key == "reopen_interval_ms") return ms(c.can_reopen_interval_us, 10.0, 60000.0, false);
-  } else if (sec == "laser") {
-    if (key == "device") {
-      if (*v == '\0' || std::strlen(v) > drivers::SerialOptions::kMaxPathChars) {
-        *why = "device path must be 1..127 characters";
-        return R::kBad;
-      }
-      c.laser_device = v;
-      return R::kOk;
-    }
-    if (key == "protocol") {
-      const std::string p(v);
-      if (p == "scip") c.laser_protocol = LaserProtocol::kScip;
-      else if (p == "sick") c.laser_protocol = LaserProtocol::kSick;
-      else {
-        *why = "'" + p + "' is not a laser protocol (scip, sick)";
-        return R::kBad;
-      }
-      return R::kOk;
-    }
-    if (key == "baud") {
-      static constexpr long long kRates[] = {9600, 19200, 38400, 57600, 115200, 230400, 250000, 460800, 500000, 750000, 921600};
-      if (!int_in(v, 1, 4000000, &i, why)) return R::kBad;
-      for (long long r : kRates) {
-        if (r == i) {
-          c.laser_baud = static_cast<std::uint32_t>(i);
-          return R::kOk;
-        }
-      }
-      *why = std::string(v) + " is not a supported line speed (9600 ... 921600)";
-      return R::kBad;
-    }
-    if (key == "scip_cluster") {
-      if (!int_in(v, 1, 99, &i, why)) return R::kBad;
-      c.urg.cluster = static_cast<std::uint32_t>(i);
-      return R::kOk;
-    }
-    if (key == "sick_baud") {
-      if (!int_in(v, 9600, 500000, &i, why)) return R::kBad;
-      c.sick.target_baud = static_cast<std::uint32_t>(i);
-      if (!drivers::validate(c.sick)) {
-        *why = std::string(v) + ": the LMS2xx offers 9600, 19200, 38400 or 500000";
-        return R::kBad;
-      }
-      return R::kOk;
-    }
-    if (key == "sick_angle_deg" || key == "sick_resolution_cdeg") {
-      if (!int_in(v, 1, 180, &i, why)) return R::kBad;
-      (key == "sick_angle_deg" ? c.sick.angle_deg : c.sick.resolution_cdeg) = static_cast<std::uint16_t>(i);
-      return R::kOk;  // the combination is checked once the file is read
-    }
-    if (key == "reply_timeout_ms") {
-      const R r = ms(c.urg.reply_timeout_us, 10.0, 60000.0, false);
-      c.sick.reply_timeout_us = c.urg.reply_timeout_us;
-      return r;
-    }
-    if (key == "stall_timeout_ms") {
-      const R r = ms(c.urg.stall_timeout_us, 10.0, 60000.0, false);
-      c.sick.stall_timeout_us = c.urg.stall_timeout_us;
-      return r;
-    }
-    if (key == "reopen_interval_ms") return ms(c.laser_reopen_interval_us, 10.0, 60000.0, false);
-    if (key == "x_m") return real(c.laser_in_base.x_m, -10.0, 10.0, false);
-    if (key == "y_m") return real(c.laser_in_base.y_m, -10.0, 10.0, false);
-    if (key == "heading_rad") return real(c.laser_in_base.heading_rad, -det::kPi, det::kPi, false);
-  } else if (sec == "robot") {
-    drivers::DiffDriveParams& p = c.drive;
-    if (key == "ticks_per_rev") return real(p.ticks_per_rev, 0.0, 1e9, true);
-    if (key == "gear_ratio") return real(p.gear_ratio, 0.0, 1e6, true);
-    if (key == "left_radius_m") return real(p.left_radius_m, 0.0, 5.0, true);
-    if (key == "right_radius_m") return real(p.right_radius_m, 0.0, 5.0, true);
-    if (key == "wheel_separation_m") return real(p.wheel_separation_m, 0.0, 20.0, true);
-    if (key == "left_sign" || key == "right_sign") {
-      if (!int_in(v, -1, 1, &i, why) || i == 0) {
-        *why = std::string(v) + ": a direction sign is 1 or -1";
-        return R::kBad;
-      }
-      (key == "left_sign" ? p.left_sign : p.right_sign) = static_cast<int>(i);
-      return R::kOk;
-    }
-    if (key == "counter_bits") {
-      if (!int_in(v, 16, 32, &i, why) || (i != 16 && i != 32)) {
-        *why = std::string(v) + ": counter_bits must be 16 or 32";
-        return R::kBad;
-      }
-      p.counter_bits = static_cast<std::uint8_t>(i);
-      return R::kOk;
-    }
-  } else if (sec == "sync") {
-    if (key == "odometry_wait_ms") return ms(c.odometry_wait_us, 0.0, 5000.0, false);
-    if (key == "max_interpolation_gap_ms") return ms(c.max_interpolation_gap_us, 1.0, 10000.0, false);
-    if (key == "scan_queue") {
-      if (!int_in(v, 1, DaemonConfig::kMaxScanQueue, &i, why)) return R::kBad;
-      c.scan_queue = static_cast<std::uint32_t>(i);
-      return R::kOk;
-    }
-  } else if (sec == "slam") {
-    if (key == "mode") {
-      if (!parse_mode(v, &c.mode)) {
-        *why = "'" + std::string(v) + "' is not a SLAM mode (sdp, dpslam, localize)";
-        return R::kBad;
-      }
-      return R::kOk;
-    }
-    if (key == "profile") {
-      if (!parse_sdp_profile(v, &c.profile)) {
-        *why = "'" + std::string(v) + "' is not a profile (accurate, paper)";
-        return R::kBad;
-      }
-      return R::kOk;
-    }
-    if (key == "seed") {
-      if (*v == '-' || !int_in(v, 0, 0x7FFFFFFFFFFFFFFFLL, &i, why)) {
-        if (why->empty()) *why = std::string(v) + " is not a non-negative integer";
-        return R::kBad;
-      }
-      c.seed = static_cast<std::uint64_t>(i);
-      return R::kOk;
-    }
-  } else if (sec == "sdp") {
-    // The offline runner's own [sdp] parser: same keys, values and ranges; its reasons
-    // already name "[sdp] key" or the option.
+  if (!int_in(v, lo, hi, &i, why)) return false;
+  *field = static_cast<T>(i);
+  return true;
+}
+bool set_path(std::string* field, const char* v, const char* what, std::string* why) {
+  if (*v == '\0') {
+    *why = std::string("empty ") + what;
+    return false;
+  }
+  *field = v;
+  return true;
+}
+std::string ms_text(std::int64_t us) { return slam::real_text(static_cast<double>(us) / 1000.0); }
+std::string s_text(std::int64_t us) { return slam::real_text(static_cast<double>(us) / 1.0e6); }
+std::string num(double v) { return slam::real_text(v); }
+std::string bool_text(bool b) { return b ? "true" : "false"; }
+
+using C = DaemonConfig;
+using W = std::string*;
+
+// Every key of the daemon's own sections, in the order of sdpslamd.ini (which documents
+// each: test_config checks that it holds every row with its default). A row's range is
+// its setter's; the checks that join keys run once the file is read (load_daemon_config).
+const DaemonKey kKeys[] = {
+    {"can", "interface", "", "1..15 characters", "SocketCAN interface",
+     [](C& c, const char* v, W why) {
+       const std::size_t n = std::strlen(v);
+       if (n == 0U || n > 15U || std::strchr(v, '/') != nullptr || std::strchr(v, ' ') != nullptr) {
+         *why = "interface name must be 1..15 characters without '/' or spaces";
+         return false;
+       }
+       c.can_interface = v;
+       return true;
+     },
+     [](const C& c) { return c.can_interface; }},
+    {"can", "protocol", "", "canopen | odrive", "wheel encoders: CANopen (CiA 406 TPDO1) or ODrive (CAN Simple)",
+     [](C& c, const char* v, W why) {
+       if (drivers::parse_encoder_protocol(v, c.encoders.protocol)) return true;
+       *why = "'" + std::string(v) + "' is not an encoder protocol (canopen, odrive)";
+       return false;
+     },
+     [](const C& c) { return std::string(drivers::to_string(c.encoders.protocol)); }},
+    // CANopen node ids are 1..127 (CiA 301), ODrive axis ids 0..63 (6 bits of the 11-bit
+    // id): the range depends on [can] protocol, so it is checked once the file is read.
+    {"can", "left_node", "", "CANopen 1..127, ODrive 0..63", "node id of the left wheel",
+     [](C& c, const char* v, W why) {
+       if (!set_int(&c.encoders.canopen.left_node, v, 0, 127, why)) return false;
+       c.encoders.odrive.left_node = c.encoders.canopen.left_node;
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.encoders.canopen.left_node); }},
+    {"can", "right_node", "", "CANopen 1..127, ODrive 0..63", "node id of the right wheel, not left_node",
+     [](C& c, const char* v, W why) {
+       if (!set_int(&c.encoders.canopen.right_node, v, 0, 127, why)) return false;
+       c.encoders.odrive.right_node = c.encoders.canopen.right_node;
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.encoders.canopen.right_node); }},
+    {"can", "position_bytes", "", "4 | 2", "CANopen TPDO1 position size",
+     [](C& c, const char* v, W why) {
+       long long i = 0;
+       if (!int_in(v, 2, 4, &i, why) || i == 3) {
+         *why = std::string(v) + ": position_bytes must be 2 or 4";
+         return false;
+       }
+       c.encoders.canopen.position_bytes = static_cast<std::uint8_t>(i);
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.encoders.canopen.position_bytes); }},
+    {"can", "send_nmt_start", "", "true | false", "CANopen: NMT start both nodes at start",
+     [](C& c, const char* v, W why) { return boolean(v, &c.encoders.canopen.send_nmt_start, why); },
+     [](const C& c) { return bool_text(c.encoders.canopen.send_nmt_start); }},
+    {"can", "sync_period_ms", "ms", "[0, 1000]", "CANopen: produce SYNC this often (0 = another node does)",
+     [](C& c, const char* v, W why) { return set_us(&c.encoders.canopen.sync_period_us, v, 0.0, 1000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.encoders.canopen.sync_period_us); }},
+    {"can", "position_timeout_ms", "ms", "[1, 10000]", "a wheel without a position for this long is stale",
+     [](C& c, const char* v, W why) {
+       if (!set_us(&c.encoders.canopen.position_timeout_us, v, 1.0, 10000.0, 1e3, why)) return false;
+       c.encoders.odrive.position_timeout_us = c.encoders.canopen.position_timeout_us;
+       return true;
+     },
+     [](const C& c) { return ms_text(c.encoders.canopen.position_timeout_us); }},
+    {"can", "heartbeat_timeout_ms", "ms", "[0, 60000]", "heartbeat supervision (0 = off)",
+     [](C& c, const char* v, W why) {
+       if (!set_us(&c.encoders.canopen.heartbeat_timeout_us, v, 0.0, 60000.0, 1e3, why)) return false;
+       c.encoders.odrive.heartbeat_timeout_us = c.encoders.canopen.heartbeat_timeout_us;
+       return true;
+     },
+     [](const C& c) { return ms_text(c.encoders.canopen.heartbeat_timeout_us); }},
+    {"can", "odrive_counts_per_turn", "", "[1, 1e7]", "ODrive: counter counts per encoder turn",
+     [](C& c, const char* v, W why) { return set_real(&c.encoders.odrive.counts_per_turn, v, 1.0, 1e7, false, why); },
+     [](const C& c) { return num(c.encoders.odrive.counts_per_turn); }},
+    {"can", "odrive_request_period_ms", "ms", "[0, 1000]", "ODrive: RTR request period (0 = axes stream)",
+     [](C& c, const char* v, W why) { return set_us(&c.encoders.odrive.request_period_us, v, 0.0, 1000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.encoders.odrive.request_period_us); }},
+    {"can", "reopen_interval_ms", "ms", "[10, 60000]", "interface down or bus-off: re-open attempt period",
+     [](C& c, const char* v, W why) { return set_us(&c.can_reopen_interval_us, v, 10.0, 60000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.can_reopen_interval_us); }},
+    {"laser", "device", "", "1..127 characters", "serial device of the laser",
+     [](C& c, const char* v, W why) {
+       if (*v == '\0' || std::strlen(v) > drivers::SerialOptions::kMaxPathChars) {
+         *why = "device path must be 1..127 characters";
+         return false;
+       }
+       c.laser_device = v;
+       return true;
+     },
+     [](const C& c) { return c.laser_device; }},
+    {"laser", "protocol", "", "scip | sick", "Hokuyo URG (SCIP 2.0) or SICK LMS200/291",
+     [](C& c, const char* v, W why) {
+       const std::string p(v);
+       if (p == "scip") {
+         c.laser_protocol = LaserProtocol::kScip;
+       } else if (p == "sick") {
+         c.laser_protocol = LaserProtocol::kSick;
+       } else {
+         *why = "'" + p + "' is not a laser protocol (scip, sick)";
+         return false;
+       }
+       return true;
+     },
+     [](const C& c) { return std::string(to_string(c.laser_protocol)); }},
+    {"laser", "baud", "", "9600 .. 921600 standard rates", "SCIP line speed (ignored over USB-ACM)",
+     [](C& c, const char* v, W why) {
+       static constexpr long long kRates[] = {9600,   19200,  38400,  57600,  115200, 230400,
+                                              250000, 460800, 500000, 750000, 921600};
+       long long i = 0;
+       if (!int_in(v, 1, 4000000, &i, why)) return false;
+       for (long long r : kRates) {
+         if (r == i) {
+           c.laser_baud = static_cast<std::uint32_t>(i);
+           return true;
+         }
+       }
+       *why = std::string(v) + " is not a supported line speed (9600 ... 921600)";
+       return false;
+     },
+     [](const C& c) { return std::to_string(c.laser_baud); }},
+    {"laser", "scip_cluster", "", "1..99", "SCIP: steps merged per beam",
+     [](C& c, const char* v, W why) { return set_int(&c.urg.cluster, v, 1, 99, why); },
+     [](const C& c) { return std::to_string(c.urg.cluster); }},
+    {"laser", "sick_baud", "", "9600 | 19200 | 38400 | 500000", "SICK: line speed switched to after start",
+     [](C& c, const char* v, W why) {
+       if (!set_int(&c.sick.target_baud, v, 9600, 500000, why)) return false;
+       if (drivers::validate(c.sick)) return true;
+       *why = std::string(v) + ": the LMS2xx offers 9600, 19200, 38400 or 500000";
+       return false;
+     },
+     [](const C& c) { return std::to_string(c.sick.target_baud); }},
+    // The variant (angle and resolution together) is checked once the file is read.
+    {"laser", "sick_angle_deg", "deg", "100 | 180", "SICK scan variant",
+     [](C& c, const char* v, W why) { return set_int(&c.sick.angle_deg, v, 1, 180, why); },
+     [](const C& c) { return std::to_string(c.sick.angle_deg); }},
+    {"laser", "sick_resolution_cdeg", "1/100 deg", "25 | 50 | 100", "SICK angular step",
+     [](C& c, const char* v, W why) { return set_int(&c.sick.resolution_cdeg, v, 1, 180, why); },
+     [](const C& c) { return std::to_string(c.sick.resolution_cdeg); }},
+    {"laser", "reply_timeout_ms", "ms", "[10, 60000]", "a command without reply is re-sent after this",
+     [](C& c, const char* v, W why) {
+       if (!set_us(&c.urg.reply_timeout_us, v, 10.0, 60000.0, 1e3, why)) return false;
+       c.sick.reply_timeout_us = c.urg.reply_timeout_us;
+       return true;
+     },
+     [](const C& c) { return ms_text(c.urg.reply_timeout_us); }},
+    {"laser", "stall_timeout_ms", "ms", "[10, 60000]", "streaming without a scan this long restarts the sensor",
+     [](C& c, const char* v, W why) {
+       if (!set_us(&c.urg.stall_timeout_us, v, 10.0, 60000.0, 1e3, why)) return false;
+       c.sick.stall_timeout_us = c.urg.stall_timeout_us;
+       return true;
+     },
+     [](const C& c) { return ms_text(c.urg.stall_timeout_us); }},
+    {"laser", "reopen_interval_ms", "ms", "[10, 60000]", "unplugged device: re-open attempt period",
+     [](C& c, const char* v, W why) { return set_us(&c.laser_reopen_interval_us, v, 10.0, 60000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.laser_reopen_interval_us); }},
+    {"laser", "x_m", "m", "[-10, 10]", "laser mounting pose in the base frame: x forward",
+     [](C& c, const char* v, W why) { return set_real(&c.laser_in_base.x_m, v, -10.0, 10.0, false, why); },
+     [](const C& c) { return num(c.laser_in_base.x_m); }},
+    {"laser", "y_m", "m", "[-10, 10]", "y left",
+     [](C& c, const char* v, W why) { return set_real(&c.laser_in_base.y_m, v, -10.0, 10.0, false, why); },
+     [](const C& c) { return num(c.laser_in_base.y_m); }},
+    {"laser", "heading_rad", "rad", "[-pi, pi]", "rotation",
+     [](C& c, const char* v, W why) {
+       return set_real(&c.laser_in_base.heading_rad, v, -det::kPi, det::kPi, false, why);
+     },
+     [](const C& c) { return num(c.laser_in_base.heading_rad); }},
+    {"robot", "ticks_per_rev", "", "> 0", "encoder counts per encoder revolution",
+     [](C& c, const char* v, W why) { return set_real(&c.drive.ticks_per_rev, v, 0.0, 1e9, true, why); },
+     [](const C& c) { return num(c.drive.ticks_per_rev); }},
+    {"robot", "gear_ratio", "", "> 0", "wheel revolutions per encoder revolution",
+     [](C& c, const char* v, W why) { return set_real(&c.drive.gear_ratio, v, 0.0, 1e6, true, why); },
+     [](const C& c) { return num(c.drive.gear_ratio); }},
+    {"robot", "left_radius_m", "m", "(0, 5]", "left wheel radius",
+     [](C& c, const char* v, W why) { return set_real(&c.drive.left_radius_m, v, 0.0, 5.0, true, why); },
+     [](const C& c) { return num(c.drive.left_radius_m); }},
+    {"robot", "right_radius_m", "m", "(0, 5]", "right wheel radius",
+     [](C& c, const char* v, W why) { return set_real(&c.drive.right_radius_m, v, 0.0, 5.0, true, why); },
+     [](const C& c) { return num(c.drive.right_radius_m); }},
+    {"robot", "wheel_separation_m", "m", "(0, 20]", "distance between the wheel contact points",
+     [](C& c, const char* v, W why) { return set_real(&c.drive.wheel_separation_m, v, 0.0, 20.0, true, why); },
+     [](const C& c) { return num(c.drive.wheel_separation_m); }},
+    {"robot", "left_sign", "", "1 | -1", "counts increase when the wheel drives forward",
+     [](C& c, const char* v, W why) {
+       long long i = 0;
+       if (!int_in(v, -1, 1, &i, why) || i == 0) {
+         *why = std::string(v) + ": a direction sign is 1 or -1";
+         return false;
+       }
+       c.drive.left_sign = static_cast<int>(i);
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.drive.left_sign); }},
+    {"robot", "right_sign", "", "1 | -1", "the same for the right wheel",
+     [](C& c, const char* v, W why) {
+       long long i = 0;
+       if (!int_in(v, -1, 1, &i, why) || i == 0) {
+         *why = std::string(v) + ": a direction sign is 1 or -1";
+         return false;
+       }
+       c.drive.right_sign = static_cast<int>(i);
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.drive.right_sign); }},
+    {"robot", "counter_bits", "", "16 | 32", "encoder counter width",
+     [](C& c, const char* v, W why) {
+       long long i = 0;
+       if (!int_in(v, 16, 32, &i, why) || (i != 16 && i != 32)) {
+         *why = std::string(v) + ": counter_bits must be 16 or 32";
+         return false;
+       }
+       c.drive.counter_bits = static_cast<std::uint8_t>(i);
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.drive.counter_bits); }},
+    {"sync", "odometry_wait_ms", "ms", "[0, 5000]", "a scan newer than the newest odometry waits this long",
+     [](C& c, const char* v, W why) { return set_us(&c.odometry_wait_us, v, 0.0, 5000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.odometry_wait_us); }},
+    {"sync", "max_interpolation_gap_ms", "ms", "[1, 10000]", "odometry samples farther apart are not interpolated",
+     [](C& c, const char* v, W why) { return set_us(&c.max_interpolation_gap_us, v, 1.0, 10000.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.max_interpolation_gap_us); }},
+    {"sync", "scan_queue", "", "1..16", "scans waiting for odometry",
+     [](C& c, const char* v, W why) { return set_int(&c.scan_queue, v, 1, DaemonConfig::kMaxScanQueue, why); },
+     [](const C& c) { return std::to_string(c.scan_queue); }},
+    {"slam", "mode", "", "sdp | dpslam | localize", "SDP-SLAM, the bottom filter alone, or localization on a map",
+     [](C& c, const char* v, W why) {
+       if (parse_mode(v, &c.mode)) return true;
+       *why = "'" + std::string(v) + "' is not a SLAM mode (sdp, dpslam, localize)";
+       return false;
+     },
+     [](const C& c) { return std::string(to_string(c.mode)); }},
+    {"slam", "profile", "", "accurate | paper", "where sdp mode's options start",
+     [](C& c, const char* v, W why) {
+       if (parse_sdp_profile(v, &c.profile)) return true;
+       *why = "'" + std::string(v) + "' is not a profile (accurate, paper)";
+       return false;
+     },
+     [](const C& c) { return std::string(to_string(c.profile)); }},
+    {"slam", "seed", "", ">= 0", "random seed (same input and seed, same output)",
+     [](C& c, const char* v, W why) {
+       long long i = 0;
+       if (*v == '-' || !int_in(v, 0, 0x7FFFFFFFFFFFFFFFLL, &i, why)) {
+         if (why->empty()) *why = std::string(v) + " is not a non-negative integer";
+         return false;
+       }
+       c.seed = static_cast<std::uint64_t>(i);
+       return true;
+     },
+     [](const C& c) { return std::to_string(c.seed); }},
+    {"localize", "map", "", "a path or empty", "the saved map (its map.yaml); required in mode localize",
+     [](C& c, const char* v, W) {
+       c.localize_map = v;  // empty: none (mode localize refuses that once the file is read)
+       return true;
+     },
+     [](const C& c) { return c.localize_map; }},
+    {"localize", "start", "m, m, rad", "x, y, theta or empty", "the start pose in the map (empty: global localization)",
+     [](C& c, const char* v, W why) {
+       if (*v == '\0') {
+         c.localize_have_start = false;
+         return true;
+       }
+       if (!slam::parse_start_pose(v, &c.localize_start)) {
+         *why = "'" + std::string(v) + "' is not a pose x, y, theta (m, m, rad) in the map's frame";
+         return false;
+       }
+       c.localize_have_start = true;
+       return true;
+     },
+     [](const C& c) {
+       return c.localize_have_start
+                  ? num(c.localize_start.x_m) + ", " + num(c.localize_start.y_m) + ", " + num(c.localize_start.heading_rad)
+                  : std::string();
+     }},
+    {"localize", "min_particles", "", "[10, 1000000]", "KLD sampling floor",
+     [](C& c, const char* v, W why) { return set_int(&c.localize.min_particles, v, 10, 1000000, why); },
+     [](const C& c) { return std::to_string(c.localize.min_particles); }},
+    {"localize", "max_particles", "", "[10, 1000000]", "KLD sampling ceiling (and memory)",
+     [](C& c, const char* v, W why) { return set_int(&c.localize.max_particles, v, 10, 1000000, why); },
+     [](const C& c) { return std::to_string(c.localize.max_particles); }},
+    {"output", "directory", "", "a path", "where maps, trajectories and status go",
+     [](C& c, const char* v, W why) { return set_path(&c.output_directory, v, "output directory", why); },
+     [](const C& c) { return c.output_directory; }},
+    {"output", "period_s", "s", "[0.1, 3600]", "outputs written this often",
+     [](C& c, const char* v, W why) { return set_us(&c.output_period_us, v, 0.1, 3600.0, 1e6, why); },
+     [](const C& c) { return s_text(c.output_period_us); }},
+    {"output", "max_trajectory_scans", "", "[1, 10000000]", "trajectory poses kept",
+     [](C& c, const char* v, W why) { return set_int(&c.max_trajectory_scans, v, 1, 10000000, why); },
+     [](const C& c) { return std::to_string(c.max_trajectory_scans); }},
+    {"output", "write_map", "", "true | false", "write the map with the outputs",
+     [](C& c, const char* v, W why) { return boolean(v, &c.write_map, why); },
+     [](const C& c) { return bool_text(c.write_map); }},
+    {"output", "input_log", "", "true | false", "record every scan fed to SLAM to <directory>/input.clf",
+     [](C& c, const char* v, W why) { return boolean(v, &c.input_log, why); },
+     [](const C& c) { return bool_text(c.input_log); }},
+    {"output", "pose_socket", "", "a path or empty", "each placed scan's pose to this UNIX datagram socket (empty: off)",
+     [](C& c, const char* v, W why) {
+       if (std::strlen(v) >= sizeof(sockaddr_un{}.sun_path)) {
+         *why = "a socket path has at most " + std::to_string(sizeof(sockaddr_un{}.sun_path) - 1U) + " bytes";
+         return false;
+       }
+       c.pose_socket = v;
+       return true;
+     },
+     [](const C& c) { return c.pose_socket; }},
+    {"output", "snapshot_interval_s", "s", "[0, 86400]", "mode sdp: the whole state saved this often (0 = never)",
+     [](C& c, const char* v, W why) { return set_us(&c.snapshot_interval_us, v, 0.0, 86400.0, 1e6, why); },
+     [](const C& c) { return s_text(c.snapshot_interval_us); }},
+    {"daemon", "log_interval_s", "s", "[0, 3600]", "one log line per event kind at most this often",
+     [](C& c, const char* v, W why) { return set_us(&c.log_interval_us, v, 0.0, 3600.0, 1e6, why); },
+     [](const C& c) { return s_text(c.log_interval_us); }},
+    {"daemon", "loop_slice_ms", "ms", "[0.1, 100]", "longest wait on the laser before CAN is read",
+     [](C& c, const char* v, W why) { return set_us(&c.loop_slice_us, v, 0.1, 100.0, 1e3, why); },
+     [](const C& c) { return ms_text(c.loop_slice_us); }},
+    {"daemon", "memory_budget_mib", "MiB", "[8, 65536]", "the SLAM state may not exceed this",
+     [](C& c, const char* v, W why) { return set_int(&c.memory_budget_mib, v, 8, 65536, why); },
+     [](const C& c) { return std::to_string(c.memory_budget_mib); }},
+};
+
+R handle_key(DaemonConfig& c, const std::string& sec, const std::string& key, const char* v, std::string* why) {
+  if (sec == "sdp") {
+    // The offline runner's own [sdp] reading: same keys, values and ranges; its reasons
+    // already name "sdp.key".
     switch (slam::apply_sdp_key(&c.sdp, key, v, why)) {
       case slam::SdpKeyResult::kApplied: return R::kOk;
       case slam::SdpKeyResult::kInvalid: return R::kBad;
       case slam::SdpKeyResult::kUnknown: return R::kUnknown;
     }
-  } else if (sec == "localize") {
-    if (key == "map") return path(c.localize_map, "map path");
-    if (key == "start") {
-      if (*v == '\0') {  // empty: global localization
-        c.localize_have_start = false;
-        return R::kOk;
-      }
-      if (!slam::parse_start_pose(v, &c.localize_start)) {
-        *why = "'" + std::string(v) + "' is not a pose x, y, theta (m, m, rad) in the map's frame";
-        return R::kBad;
-      }
-      c.localize_have_start = true;
-      return R::kOk;
-    }
-    if (key == "min_particles" || key == "max_particles") {
-      if (!int_in(v, 10, 1000000, &i, why)) return R::kBad;
-      (key == "min_particles" ? c.localize.min_particles : c.localize.max_particles) = static_cast<std::uint32_t>(i);
-      return R::kOk;
-    }
-  } else if (sec == "output") {
-    if (key == "directory") return path(c.output_directory, "output directory");
-    if (key == "period_s") {
-      if (!real_in(v, 0.1, 3600.0, false, &d, why)) return R::kBad;
-      c.output_period_us = static_cast<std::int64_t>(std::llround(d * 1e6));
-      return R::kOk;
-    }
-    if (key == "max_trajectory_scans") {
-      if (!int_in(v, 1, 10000000, &i, why)) return R::kBad;
-      c.max_trajectory_scans = static_cast<std::uint32_t>(i);
-      return R::kOk;
-    }
-    if (key == "write_map") return ok(boolean(v, &c.write_map, why));
-    if (key == "input_log") return ok(boolean(v, &c.input_log, why));
-    if (key == "pose_socket") {
-      if (std::strlen(v) >= sizeof(sockaddr_un{}.sun_path)) {
-        *why = "a socket path has at most " + std::to_string(sizeof(sockaddr_un{}.sun_path) - 1U) + " bytes";
-        return R::kBad;
-      }
-      c.pose_socket = v;
-      return R::kOk;
-    }
-    if (key == "snapshot_interval_s") {
-      if (!real_in(v, 0.0, 86400.0, false, &d, why)) return R::kBad;
-      c.snapshot_interval_us = static_cast<std::int64_t>(std::llround(d * 1e6));
-      return R::kOk;
-    }
-  } else if (sec == "daemon") {
-    if (key == "log_interval_s") {
-      if (!real_in(v, 0.0, 3600.0, false, &d, why)) return R::kBad;
-      c.log_interval_us = static_cast<std::int64_t>(std::llround(d * 1e6));
-      return R::kOk;
-    }
-    if (key == "loop_slice_ms") return ms(c.loop_slice_us, 0.1, 100.0, false);
-    if (key == "memory_budget_mib") {
-      if (!int_in(v, 8, 65536, &i, why)) return R::kBad;
-      c.memory_budget_mib = static_cast<std::uint32_t>(i);
-      return R::kOk;
-    }
-  } else {
-    std::string slam_why;
-    switch (slam::apply_config_key(&c.slam, sec, key, v, &slam_why)) {
+  }
+  if (slam::is_slam_config_section(sec)) {
+    switch (slam::apply_config_key(&c.slam, sec, key, v, why)) {
       case slam::ConfigKeyResult::kApplied: return R::kOk;
-      case slam::ConfigKeyResult::kInvalid: *why = slam_why; return R::kBad;
-      case slam::ConfigKeyResult::kUnknown:
-        if (!slam::is_slam_config_section(sec)) {
-          *why = "unknown section [" + sec + "]";
-          return R::kBad;
-        }
-        break;
+      case slam::ConfigKeyResult::kInvalid: return R::kBad;
+      case slam::ConfigKeyResult::kUnknown: return R::kUnknown;
     }
+  }
+  for (const DaemonKey& k : kKeys) {
+    if (sec == k.section && key == k.key) return k.apply(c, v, why) ? R::kOk : R::kBad;
   }
   return R::kUnknown;
 }
@@ -370,6 +474,28 @@ bool shapes_slam_state(const std::string& sec, const char* name) {
 }
 
 }  // namespace
+
+const DaemonKey* daemon_keys(std::size_t* count) {
+  *count = sizeof kKeys / sizeof kKeys[0];
+  return kKeys;
+}
+
+std::string effective_config_ini(const DaemonConfig& config) {
+  std::string out;
+  const char* section = nullptr;
+  for (const DaemonKey& k : kKeys) {
+    if (section == nullptr || std::strcmp(section, k.section) != 0) {
+      section = k.section;
+      out += (out.empty() ? "[" : "\n[") + std::string(section) + "]\n";
+    }
+    std::string line = std::string(k.key) + " = " + k.text(config);
+    if (line.size() < 40U) line.resize(40U, ' ');
+    out += line + " ; " + (k.unit[0] != '\0' ? std::string(k.unit) + ", " : std::string()) + k.range + ": " + k.doc + "\n";
+  }
+  out += "\n" + slam::options_ini_text(DpSlamOptions::table(), config.slam.filter);
+  if (config.mode == SlamMode::kSdp) out += "\n" + slam::options_ini_text(SdpOptions::table(), config.sdp);
+  return out;
+}
 
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error) {
   std::FILE* f = slam::open_config_file(path, error);

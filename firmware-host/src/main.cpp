@@ -28,7 +28,6 @@
 #include "sdpslam/drivers/socketcan_bus.h"
 #include "sdpslam/drivers/systemd_notifier.h"
 #include "sdpslam/drivers/urg_scip2_laser.h"
-#include "sdpslam/slam/option_text.h"
 
 namespace {
 
@@ -148,12 +147,8 @@ int run_daemon(int argc, char** argv) {
                 daemon::to_string(config.laser_protocol), config.laser_device.c_str(),
                 drivers::to_string(config.encoders.protocol), config.can_interface.c_str(),
                 config.output_directory.c_str());
-    // The SLAM options in effect (profile and file applied), as INI: nothing hidden.
-    std::printf("; effective SLAM configuration (profile %s)\n%s", to_string(config.profile),
-                slam::options_ini_text(DpSlamOptions::table(), config.slam.filter).c_str());
-    if (config.mode == daemon::SlamMode::kSdp) {
-      std::printf("\n%s", slam::options_ini_text(SdpOptions::table(), config.sdp).c_str());
-    }
+    // The options in effect (profile and file applied), as INI: nothing hidden.
+    std::printf("; the configuration in effect\n%s", daemon::effective_config_ini(config).c_str());
     return kExitOk;
   }
 

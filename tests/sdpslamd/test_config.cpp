@@ -4,10 +4,13 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "sdpslam/daemon/daemon_config.h"
+#include "sdpslam/slam/option_text.h"
+#include "sdpslam/slam/ini_document.h"
 #include "sdpslam/daemon/slam_engine.h"
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/slam/run_sdp.h"
@@ -57,117 +60,63 @@ TEST(SdpslamdConfig, shipped_example_config_loads_with_documented_defaults) {
 }
 
 // Every key the shipped sdpslamd.ini sets has its built-in value: the file documents the
-// defaults, it does not change them. Each key the file sets is compared field by field
-// with an empty file's configuration; a key the table below does not know fails the test,
-// so a key added to the file is checked too.
+// defaults, it does not change them. Derived from the option tables (the daemon's keys,
+// DpSlamOptions::table, SdpOptions::table): every daemon key is in the file (set, or
+// commented where it has no default), and every key the file sets is a row of a table.
 TEST(SdpslamdConfig, the_shipped_file_sets_every_key_to_its_built_in_default) {
   DaemonConfig shipped;
   DaemonConfig empty;
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAMD_EXAMPLE_INI, &shipped, &error), error.c_str());
   CHECK_TRUE_TEXT(load_daemon_config(write_ini(""), &empty, &error), error.c_str());
-  using Same = bool (*)(const DaemonConfig&, const DaemonConfig&);
-  struct Field {
-    const char* key;
-    Same same;
-  };
-#define SDPSLAM_FIELD(key, member) {key, [](const DaemonConfig& a, const DaemonConfig& b) { return a.member == b.member; }}
-  static const Field kFields[] = {
-      SDPSLAM_FIELD("can.interface", can_interface),
-      SDPSLAM_FIELD("can.protocol", encoders.protocol),
-      SDPSLAM_FIELD("can.left_node", encoders.canopen.left_node),
-      SDPSLAM_FIELD("can.right_node", encoders.canopen.right_node),
-      SDPSLAM_FIELD("can.position_bytes", encoders.canopen.position_bytes),
-      SDPSLAM_FIELD("can.send_nmt_start", encoders.canopen.send_nmt_start),
-      SDPSLAM_FIELD("can.sync_period_ms", encoders.canopen.sync_period_us),
-      SDPSLAM_FIELD("can.position_timeout_ms", encoders.canopen.position_timeout_us),
-      SDPSLAM_FIELD("can.heartbeat_timeout_ms", encoders.canopen.heartbeat_timeout_us),
-      SDPSLAM_FIELD("can.odrive_counts_per_turn", encoders.odrive.counts_per_turn),
-      SDPSLAM_FIELD("can.odrive_request_period_ms", encoders.odrive.request_period_us),
-      SDPSLAM_FIELD("can.reopen_interval_ms", can_reopen_interval_us),
-      SDPSLAM_FIELD("laser.device", laser_device),
-      SDPSLAM_FIELD("laser.protocol", laser_protocol),
-      SDPSLAM_FIELD("laser.baud", laser_baud),
-      SDPSLAM_FIELD("laser.scip_cluster", urg.cluster),
-      SDPSLAM_FIELD("laser.sick_baud", sick.target_baud),
-      SDPSLAM_FIELD("laser.sick_angle_deg", sick.angle_deg),
-      SDPSLAM_FIELD("laser.sick_resolution_cdeg", sick.resolution_cdeg),
-      SDPSLAM_FIELD("laser.reply_timeout_ms", urg.reply_timeout_us),
-      SDPSLAM_FIELD("laser.stall_timeout_ms", urg.stall_timeout_us),
-      SDPSLAM_FIELD("laser.reopen_interval_ms", laser_reopen_interval_us),
-      SDPSLAM_FIELD("laser.x_m", laser_in_base.x_m),
-      SDPSLAM_FIELD("laser.y_m", laser_in_base.y_m),
-      SDPSLAM_FIELD("laser.heading_rad", laser_in_base.heading_rad),
-      SDPSLAM_FIELD("robot.ticks_per_rev", drive.ticks_per_rev),
-      SDPSLAM_FIELD("robot.gear_ratio", drive.gear_ratio),
-      SDPSLAM_FIELD("robot.left_radius_m", drive.left_radius_m),
-      SDPSLAM_FIELD("robot.right_radius_m", drive.right_radius_m),
-      SDPSLAM_FIELD("robot.wheel_separation_m", drive.wheel_separation_m),
-      SDPSLAM_FIELD("robot.left_sign", drive.left_sign),
-      SDPSLAM_FIELD("robot.right_sign", drive.right_sign),
-      SDPSLAM_FIELD("robot.counter_bits", drive.counter_bits),
-      SDPSLAM_FIELD("sync.odometry_wait_ms", odometry_wait_us),
-      SDPSLAM_FIELD("sync.max_interpolation_gap_ms", max_interpolation_gap_us),
-      SDPSLAM_FIELD("sync.scan_queue", scan_queue),
-      SDPSLAM_FIELD("slam.mode", mode),
-      SDPSLAM_FIELD("slam.profile", profile),
-      SDPSLAM_FIELD("slam.seed", seed),
-      SDPSLAM_FIELD("filter.particles", slam.filter.particle_count),
-      SDPSLAM_FIELD("filter.resample_neff_ratio", slam.filter.resample_neff_ratio),
-      SDPSLAM_FIELD("filter.update_min_travel_m", slam.filter.update_min_travel_m),
-      SDPSLAM_FIELD("filter.update_min_rotation_rad", slam.filter.update_min_rotation_rad),
-      SDPSLAM_FIELD("observation.weight_beam_stride", slam.filter.beam.weight_beam_stride),
-      SDPSLAM_FIELD("map.resolution_m", slam.filter.map_resolution_m),
-      SDPSLAM_FIELD("map.width_m", slam.filter.map_width_m),
-      SDPSLAM_FIELD("map.height_m", slam.filter.map_height_m),
-      SDPSLAM_FIELD("map.observations_base", slam.filter.map_observations_base),
-      SDPSLAM_FIELD("map.observations_per_particle", slam.filter.map_observations_per_particle),
-      SDPSLAM_FIELD("sdp.top_particles", sdp.top_particles),
-      SDPSLAM_FIELD("sdp.segmentation", sdp.segmentation),
-      SDPSLAM_FIELD("sdp.period_travel_m", sdp.period_travel_m),
-      SDPSLAM_FIELD("sdp.max_segment_scans", sdp.max_segment_scans),
-      SDPSLAM_FIELD("sdp.evaluations_per_scan", sdp.evaluations_per_scan),
-      SDPSLAM_FIELD("sdp.work_cells_per_scan", sdp.work_cells_per_scan),
-      SDPSLAM_FIELD("sdp.map_tile_capacity", sdp.map_tile_capacity),
-      SDPSLAM_FIELD("sdp.map_observation_capacity", sdp.map_observation_capacity),
-      SDPSLAM_FIELD("sdp.permanent_map_tiles", sdp.permanent_map_tiles),
-      SDPSLAM_FIELD("localize.start", localize_have_start),
-      SDPSLAM_FIELD("localize.min_particles", localize.min_particles),
-      SDPSLAM_FIELD("localize.max_particles", localize.max_particles),
-      SDPSLAM_FIELD("output.directory", output_directory),
-      SDPSLAM_FIELD("output.period_s", output_period_us),
-      SDPSLAM_FIELD("output.max_trajectory_scans", max_trajectory_scans),
-      SDPSLAM_FIELD("output.write_map", write_map),
-      SDPSLAM_FIELD("output.input_log", input_log),
-      SDPSLAM_FIELD("output.pose_socket", pose_socket),
-      SDPSLAM_FIELD("output.snapshot_interval_s", snapshot_interval_us),
-      SDPSLAM_FIELD("daemon.log_interval_s", log_interval_us),
-      SDPSLAM_FIELD("daemon.loop_slice_ms", loop_slice_us),
-      SDPSLAM_FIELD("daemon.memory_budget_mib", memory_budget_mib),
-  };
-#undef SDPSLAM_FIELD
+  sdpslam::slam::IniDocument doc;
+  CHECK_TRUE_TEXT(doc.load(SDPSLAMD_EXAMPLE_INI, &error), error.c_str());
   std::ifstream in(SDPSLAMD_EXAMPLE_INI);
-  std::string line;
-  std::string section;
-  int checked = 0;
-  std::string differ;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == ';' || line[0] == ' ') continue;
-    if (line[0] == '[') {
-      section = line.substr(1, line.find(']') - 1);
-      continue;
-    }
-    const std::string key = section + "." + line.substr(0, line.find_first_of(" ="));
-    const Field* f = nullptr;
-    for (const Field& k : kFields) {
-      if (key == k.key) f = &k;
-    }
-    if (f == nullptr) FAIL(("the shipped file sets " + key + ", which this test does not compare").c_str());
-    if (!f->same(shipped, empty)) differ += " " + key;
-    ++checked;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::size_t n = 0;
+  const sdpslam::daemon::DaemonKey* keys = sdpslam::daemon::daemon_keys(&n);
+  CHECK(n > 40U);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string name = std::string(keys[i].section) + "." + keys[i].key;
+    const bool set = doc.line_of(keys[i].section, keys[i].key) > 0;
+    CHECK_TEXT(set || text.find("; " + std::string(keys[i].key) + " =") != std::string::npos,
+               ("sdpslamd.ini does not document " + name).c_str());
+    CHECK_TEXT(keys[i].doc[0] != '\0' && keys[i].range[0] != '\0', name.c_str());
+    STRCMP_EQUAL_TEXT(keys[i].text(empty).c_str(), keys[i].text(shipped).c_str(), name.c_str());
   }
-  CHECK_TEXT(differ.empty(), ("documented values that are not the built-in defaults:" + differ).c_str());
-  LONGS_EQUAL(sizeof kFields / sizeof kFields[0], checked);
+  for (const auto& row : sdpslam::DpSlamOptions::table()) {
+    STRCMP_EQUAL_TEXT(sdpslam::slam::option_text(row, empty.slam.filter).c_str(),
+                      sdpslam::slam::option_text(row, shipped.slam.filter).c_str(), row.key);
+  }
+  for (const auto& row : sdpslam::SdpOptions::table()) {
+    STRCMP_EQUAL_TEXT(sdpslam::slam::option_text(row, empty.sdp).c_str(),
+                      sdpslam::slam::option_text(row, shipped.sdp).c_str(), row.key);
+  }
+  for (const sdpslam::slam::IniEntry& e : doc.entries()) {
+    bool known = sdpslam::DpSlamOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr ||
+                 sdpslam::SdpOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr || e.section == "log";
+    for (std::size_t i = 0; i < n && !known; ++i) known = e.section == keys[i].section && e.key == keys[i].key;
+    CHECK_TEXT(known, (e.section + "." + e.key + " is in no option table").c_str());
+  }
+}
+
+// --check-config prints the configuration in effect; read back, it is the same.
+TEST(SdpslamdConfig, the_effective_configuration_reads_back_as_itself) {
+  DaemonConfig c;
+  std::string error;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini("[can]\nprotocol = odrive\nleft_node = 0\n[laser]\nx_m = 0.12\n"
+                                               "[localize]\nstart = 1, 2, 0.5\n[slam]\nprofile = paper\n[sdp]\n"
+                                               "top_particles = 40\n[output]\npose_socket = /run/p.sock\n"),
+                                     &c, &error),
+                  error.c_str());
+  const std::string text = sdpslam::daemon::effective_config_ini(c);
+  STRCMP_CONTAINS("\nleft_node = 0 ", text.c_str());
+  STRCMP_CONTAINS("\nstart = 1, 2, 0.5 ", text.c_str());
+  STRCMP_CONTAINS("\ntop_particles = 40 ", text.c_str());
+  STRCMP_CONTAINS("\nkind = odometry ", text.c_str());  // the paper profile's
+  DaemonConfig again;
+  CHECK_TRUE_TEXT(load_daemon_config(write_ini(text), &again, &error), error.c_str());
+  STRCMP_EQUAL(text.c_str(), sdpslam::daemon::effective_config_ini(again).c_str());
 }
 
 TEST(SdpslamdConfig, shipped_example_starts_sdp_from_the_accurate_profile) {

@@ -126,6 +126,28 @@ struct DaemonConfig {
 // Checks that involve several keys (SICK variant, drive geometry, filter options, and in
 // sdp mode the [sdp] options and the bottom options SDP-SLAM derives from [filter] etc.)
 // run once the file is read and name the file and the section.
+// One key of sdpslamd's own sections ([can] [laser] [robot] [sync] [slam] [localize]
+// [output] [daemon]): a row of the daemon's option table, as DpSlamOptions::table() and
+// SdpOptions::table() are for the SLAM sections. sdpslamd.ini documents every row with
+// its default (test_config checks it).
+struct DaemonKey {
+  const char* section;
+  const char* key;
+  const char* unit;   // "ms", "m", "" ...
+  const char* range;  // as documented
+  const char* doc;    // one line
+  // Reads the value: false, with *why, when it is malformed or outside the key's own
+  // range (checks that join keys run once the whole file is read).
+  bool (*apply)(DaemonConfig& config, const char* value, std::string* why);
+  std::string (*text)(const DaemonConfig& config);  // the value as its INI text
+};
+// The table, in the order of sdpslamd.ini.
+const DaemonKey* daemon_keys(std::size_t* count);
+// The configuration in effect as INI (`sdpslamd --check-config`): the daemon's own keys,
+// then the SLAM options (the filter's sections; [sdp] in mode sdp) with the profile and
+// the file applied. It reads back as the same configuration.
+std::string effective_config_ini(const DaemonConfig& config);
+
 bool load_daemon_config(const std::string& path, DaemonConfig* config, std::string* error);
 // The same from an open stream, which is read twice (the [slam] profile first) and so must
 // be seekable; it is not closed. `name` stands for the file in messages.
