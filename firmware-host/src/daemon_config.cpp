@@ -119,6 +119,15 @@ bool set_path(std::string* field, const char* v, const char* what, std::string* 
   *field = v;
   return true;
 }
+bool set_sign(int* field, const char* v, std::string* why) {
+  long long i = 0;
+  if (!int_in(v, -1, 1, &i, why) || i == 0) {
+    *why = std::string(v) + ": a direction sign is 1 or -1";
+    return false;
+  }
+  *field = static_cast<int>(i);
+  return true;
+}
 std::string ms_text(std::int64_t us) { return slam::real_text(static_cast<double>(us) / 1000.0); }
 std::string s_text(std::int64_t us) { return slam::real_text(static_cast<double>(us) / 1.0e6); }
 std::string num(double v) { return slam::real_text(v); }
@@ -307,26 +316,10 @@ const DaemonKey kKeys[] = {
      [](C& c, const char* v, W why) { return set_real(&c.drive.wheel_separation_m, v, 0.0, 20.0, true, why); },
      [](const C& c) { return num(c.drive.wheel_separation_m); }},
     {"robot", "left_sign", "", "1 | -1", "counts increase when the wheel drives forward",
-     [](C& c, const char* v, W why) {
-       long long i = 0;
-       if (!int_in(v, -1, 1, &i, why) || i == 0) {
-         *why = std::string(v) + ": a direction sign is 1 or -1";
-         return false;
-       }
-       c.drive.left_sign = static_cast<int>(i);
-       return true;
-     },
+     [](C& c, const char* v, W why) { return set_sign(&c.drive.left_sign, v, why); },
      [](const C& c) { return std::to_string(c.drive.left_sign); }},
     {"robot", "right_sign", "", "1 | -1", "the same for the right wheel",
-     [](C& c, const char* v, W why) {
-       long long i = 0;
-       if (!int_in(v, -1, 1, &i, why) || i == 0) {
-         *why = std::string(v) + ": a direction sign is 1 or -1";
-         return false;
-       }
-       c.drive.right_sign = static_cast<int>(i);
-       return true;
-     },
+     [](C& c, const char* v, W why) { return set_sign(&c.drive.right_sign, v, why); },
      [](const C& c) { return std::to_string(c.drive.right_sign); }},
     {"robot", "counter_bits", "", "16 | 32", "encoder counter width",
      [](C& c, const char* v, W why) {
