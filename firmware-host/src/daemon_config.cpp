@@ -486,6 +486,7 @@ std::string effective_config_ini(const DaemonConfig& config) {
     out += line + " ; " + (k.unit[0] != '\0' ? std::string(k.unit) + ", " : std::string()) + k.range + ": " + k.doc + "\n";
   }
   out += "\n" + slam::options_ini_text(DpSlamOptions::table(), config.slam.filter);
+  out += "\n" + slam::options_ini_text(slam::log_option_table(), config.slam.log);
   if (config.mode == SlamMode::kSdp) out += "\n" + slam::options_ini_text(SdpOptions::table(), config.sdp);
   return out;
 }

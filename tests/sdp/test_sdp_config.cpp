@@ -75,10 +75,13 @@ TEST(SdpConfig, shipped_default_ini_holds_every_table_key_with_its_default) {
   CHECK_TRUE_TEXT(slam::load_config_ini(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());
   check_table_against_default_ini(DpSlamOptions::table(), DpSlamOptions{}, c.filter, filter_accurate, filter_paper,
                                   doc, text);
-  // Every key of the file is a key of a table (or of [log]).
+  const io::LogReaderOptions log_defaults;
+  check_table_against_default_ini(slam::log_option_table(), log_defaults, c.log, log_defaults, log_defaults, doc, text);
+  // Every key of the file is a key of a table.
   for (const slam::IniEntry& e : doc.entries()) {
     const bool known = SdpOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr ||
-                       DpSlamOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr || e.section == "log";
+                       DpSlamOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr ||
+                       slam::log_option_table().find(e.section.c_str(), e.key.c_str()) != nullptr;
     CHECK_TRUE_TEXT(known, (e.section + "." + e.key).c_str());
   }
 }

@@ -94,7 +94,8 @@ TEST(SdpslamdConfig, the_shipped_file_sets_every_key_to_its_built_in_default) {
   }
   for (const sdpslam::slam::IniEntry& e : doc.entries()) {
     bool known = sdpslam::DpSlamOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr ||
-                 sdpslam::SdpOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr || e.section == "log";
+                 sdpslam::SdpOptions::table().find(e.section.c_str(), e.key.c_str()) != nullptr ||
+                 sdpslam::slam::log_option_table().find(e.section.c_str(), e.key.c_str()) != nullptr;
     for (std::size_t i = 0; i < n && !known; ++i) known = e.section == keys[i].section && e.key == keys[i].key;
     CHECK_TEXT(known, (e.section + "." + e.key + " is in no option table").c_str());
   }

@@ -163,8 +163,9 @@ int run_sdp_mode(const RunArgs& a, const slam::SlamConfig& config, const SdpOpti
   // the config's line that set it).
   if (!slam::sdp_check_options(ro, &error)) return report("", kExitUsage, slam::locate_option_error(a.config, error));
   if (a.print_config) {
-    std::printf("; sdpslam run --mode sdp --profile %s: the effective configuration\n%s\n%s", to_string(profile),
+    std::printf("; sdpslam run --mode sdp --profile %s: the effective configuration\n%s\n%s\n%s", to_string(profile),
                 slam::options_ini_text(DpSlamOptions::table(), ro.config.filter).c_str(),
+                slam::options_ini_text(slam::log_option_table(), ro.config.log).c_str(),
                 slam::options_ini_text(SdpOptions::table(), ro.sdp).c_str());
     return kExitOk;
   }
@@ -224,8 +225,9 @@ int run_dpslam_mode(const RunArgs& a, slam::SlamConfig config) {
   char why[200];
   if (!ro.config.filter.validate(why, sizeof why)) return report("", kExitUsage, slam::locate_option_error(a.config, why));
   if (a.print_config) {
-    std::printf("; sdpslam run --mode dpslam: the effective configuration\n%s",
-                slam::options_ini_text(DpSlamOptions::table(), ro.config.filter).c_str());
+    std::printf("; sdpslam run --mode dpslam: the effective configuration\n%s\n%s",
+                slam::options_ini_text(DpSlamOptions::table(), ro.config.filter).c_str(),
+                slam::options_ini_text(slam::log_option_table(), ro.config.log).c_str());
     return kExitOk;
   }
   if (const int rc = check_memory_budget(a, slam::dpslam_state_bytes(ro)); rc != kExitOk) {

@@ -63,6 +63,21 @@ bool IniDuplicates::key(const char* section, const char* name, std::string* why)
   return false;
 }
 
+namespace {
+
+const OptionSpec<io::LogReaderOptions> kLogRows[] = {
+    SDPSLAM_OPTION_F32(io::LogReaderOptions, "log", "default_range_max_m", default_range_max_m, 0.0, 1000.0, true, "m",
+                       "readings at or above this are no return when the log has no maximum"),
+    SDPSLAM_OPTION_REAL(io::LogReaderOptions, "log", "max_speed_mps", max_speed_mps, 0.0, 1000.0, "m/s",
+                        "odometry faster than this (+0.5 m) is a reset or corruption, not applied (0 = not checked)"),
+    SDPSLAM_OPTION_REAL(io::LogReaderOptions, "log", "max_turn_rate_radps", max_turn_rate_radps, 0.0, 1000.0,
+                        "rad/s", "... turning faster (+0.5 rad) (0 = not checked)"),
+};
+
+}  // namespace
+
+OptionTable<io::LogReaderOptions> log_option_table() { return {kLogRows, sizeof kLogRows / sizeof kLogRows[0]}; }
+
 bool is_slam_config_section(const std::string& section) {
   return section == "filter" || section == "motion" || section == "observation" || section == "proposal" ||
          section == "map" || section == "capacity" || section == "log";
@@ -72,23 +87,9 @@ ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& sec, con
                                  const char* value, std::string* why) {
   if (!is_slam_config_section(sec)) return ConfigKeyResult::kUnknown;
   if (sec == "log") {
-    if (key == "max_speed_mps" || key == "max_turn_rate_radps") {
-      double v = 0.0;
-      if (parse_real_text(value, &v) && v >= 0.0 && v <= 1000.0) {
-        (key == "max_speed_mps" ? config->log.max_speed_mps : config->log.max_turn_rate_radps) = v;
-        return ConfigKeyResult::kApplied;
-      }
-      *why = "log." + key + ": '" + std::string(value) + "' out of range [0, 1000] (0 = not checked)";
-      return ConfigKeyResult::kInvalid;
-    }
-    if (key != "default_range_max_m") return ConfigKeyResult::kUnknown;
-    double r = 0.0;
-    if (parse_real_text(value, &r) && r > 0.0 && r <= 1000.0) {
-      config->log.default_range_max_m = static_cast<float>(r);
-      return ConfigKeyResult::kApplied;
-    }
-    *why = "log.default_range_max_m: '" + std::string(value) + "' out of range (0, 1000]";
-    return ConfigKeyResult::kInvalid;
+    const OptionSpec<io::LogReaderOptions>* row = log_option_table().find("log", key.c_str());
+    if (row == nullptr) return ConfigKeyResult::kUnknown;
+    return set_option_text(*row, &config->log, value, why) ? ConfigKeyResult::kApplied : ConfigKeyResult::kInvalid;
   }
   const OptionSpec<DpSlamOptions>* row = DpSlamOptions::table().find(sec.c_str(), key.c_str());
   if (row == nullptr) return ConfigKeyResult::kUnknown;

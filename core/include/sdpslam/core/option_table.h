@@ -16,6 +16,7 @@ enum class OptionKind : std::uint8_t {
   kU32,     // std::uint32_t
   kBool,    // bool
   kChoice,  // an enum class with std::uint8_t underneath, named by `choices`
+  kF32,     // float
 };
 
 struct OptionChoice {
@@ -80,7 +81,7 @@ const T& option_field(const OptionSpec<Options>& spec, const Options& options) {
   return *static_cast<const T*>(spec.field(const_cast<Options&>(options)));
 }
 
-// A number's value as a double (kReal, kU32), else the choice's or bool's value.
+// A number's value as a double (kReal, kU32, kF32), else the choice's or bool's value.
 template <class Options>
 double option_number(const OptionSpec<Options>& spec, const Options& options) {
   switch (spec.kind) {
@@ -88,6 +89,7 @@ double option_number(const OptionSpec<Options>& spec, const Options& options) {
     case OptionKind::kU32: return static_cast<double>(option_field<std::uint32_t>(spec, options));
     case OptionKind::kBool: return option_field<bool>(spec, options) ? 1.0 : 0.0;
     case OptionKind::kChoice: return static_cast<double>(option_field<std::uint8_t>(spec, options));
+    case OptionKind::kF32: return static_cast<double>(option_field<float>(spec, options));
   }
   return 0.0;
 }
@@ -181,4 +183,10 @@ constexpr void* choice_address(E* p) {
     SECTION, KEY, ::sdpslam::OptionKind::kChoice,                                                                   \
         [](OPTIONS& o) -> void* { return ::sdpslam::option_detail::choice_address(&o.MEMBER); }, 0.0, 0.0, false,  \
         "", DOC, CHOICES, static_cast<std::uint8_t>(sizeof(CHOICES) / sizeof(CHOICES[0]))                           \
+  }
+#define SDPSLAM_OPTION_F32(OPTIONS, SECTION, KEY, MEMBER, MIN, MAX, MIN_OPEN, UNIT, DOC)                            \
+  ::sdpslam::OptionSpec<OPTIONS> {                                                                                  \
+    SECTION, KEY, ::sdpslam::OptionKind::kF32,                                                                      \
+        [](OPTIONS& o) -> void* { return ::sdpslam::option_detail::address<float>(&o.MEMBER); }, MIN, MAX,          \
+        MIN_OPEN, UNIT, DOC, nullptr, 0U                                                                            \
   }

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "sdpslam/core/dpslam_options.h"
+#include "sdpslam/core/option_table.h"
 #include "sdpslam/io/log_reader.h"
 
 namespace sdpslam::slam {
@@ -79,6 +80,8 @@ class IniDuplicates {
 enum class ConfigKeyResult { kApplied, kUnknown, kInvalid };
 ConfigKeyResult apply_config_key(SlamConfig* config, const std::string& section, const std::string& key,
                                  const char* value, std::string* why);
+// The [log] section's keys: the log reader's options this file sets (io::LogReaderOptions).
+OptionTable<io::LogReaderOptions> log_option_table();
 // True iff `section` is one of the sections above.
 bool is_slam_config_section(const std::string& section);
 

@@ -32,6 +32,13 @@ bool set_option_text(const OptionSpec<Options>& spec, Options* options, const ch
       parsed = parse_real_text(text, &option_field<double>(spec, trial));
       expected = "a finite number";
       break;
+    case OptionKind::kF32: {
+      double d = 0.0;
+      parsed = parse_real_text(text, &d) && d >= -3.4e38 && d <= 3.4e38;
+      if (parsed) option_field<float>(spec, trial) = static_cast<float>(d);
+      expected = "a finite number";
+      break;
+    }
     case OptionKind::kU32:
       parsed = parse_u32_text(text, &option_field<std::uint32_t>(spec, trial));
       expected = "a non-negative 32-bit integer";
@@ -75,6 +82,7 @@ template <class Options>
 std::string option_text(const OptionSpec<Options>& spec, const Options& options) {
   switch (spec.kind) {
     case OptionKind::kReal: return real_text(option_field<double>(spec, options));
+    case OptionKind::kF32: return real_text(static_cast<double>(option_field<float>(spec, options)));
     case OptionKind::kU32: return std::to_string(option_field<std::uint32_t>(spec, options));
     case OptionKind::kBool: return option_field<bool>(spec, options) ? "true" : "false";
     case OptionKind::kChoice: {
@@ -98,7 +106,8 @@ std::string option_range_text(const OptionSpec<Options>& spec) {
     case OptionKind::kU32:
       return "[" + std::to_string(static_cast<unsigned long long>(spec.min)) + ", " +
              std::to_string(static_cast<unsigned long long>(spec.max)) + "]";
-    case OptionKind::kReal: break;
+    case OptionKind::kReal:
+    case OptionKind::kF32: break;
   }
   return (spec.min_open ? "(" : "[") + real_text(spec.min) + ", " + real_text(spec.max) + "]";
 }
