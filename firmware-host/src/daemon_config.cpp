@@ -481,9 +481,7 @@ std::string effective_config_ini(const DaemonConfig& config) {
       section = k.section;
       out += (out.empty() ? "[" : "\n[") + std::string(section) + "]\n";
     }
-    std::string line = std::string(k.key) + " = " + k.text(config);
-    if (line.size() < 40U) line.resize(40U, ' ');
-    out += line + " ; " + (k.unit[0] != '\0' ? std::string(k.unit) + ", " : std::string()) + k.range + ": " + k.doc + "\n";
+    out += slam::ini_option_line(k.key, k.text(config), k.unit, k.range, k.doc);
   }
   out += "\n" + slam::options_ini_text(DpSlamOptions::table(), config.slam.filter);
   out += "\n" + slam::options_ini_text(slam::log_option_table(), config.slam.log);

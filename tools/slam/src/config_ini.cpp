@@ -4,11 +4,8 @@
 
 #include <sys/stat.h>
 
-#include <cctype>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -43,15 +40,20 @@ char* read_ini_line(std::FILE* stream, char* str, int num, std::string* why) {
   return str;
 }
 
-bool IniDuplicates::line(const char* line, std::string* why) {
+bool ini_section_header(const char* line, std::string* section) {
   const char* p = line;
   while (*p == ' ' || *p == '\t') ++p;
-  if (*p != '[') return true;
+  if (*p != '[') return false;
   const char* end = std::strchr(p, ']');
-  if (end == nullptr) return true;  // malformed: inih reports it
+  if (end == nullptr) return false;
   std::string sec(p + 1, end);
   while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
   while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
+  *section = sec;
+  return true;
+}
+
+bool IniDuplicates::section(const std::string& sec, std::string* why) {
   if (sections_.insert(sec).second) return true;
   *why = "section [" + sec + "] given twice (merge its keys into the first)";
   return false;

@@ -38,18 +38,11 @@ char* read_line(char* str, int num, void* user) {
     st->fail(why);
     return r;
   }
-  const char* p = r;
-  while (*p == ' ' || *p == '\t') ++p;
-  if (*p == '[') {
-    const char* end = std::strchr(p, ']');
-    if (end != nullptr) {
-      std::string sec(p + 1, end);
-      while (!sec.empty() && (sec.back() == ' ' || sec.back() == '\t')) sec.pop_back();
-      while (!sec.empty() && (sec.front() == ' ' || sec.front() == '\t')) sec.erase(0, 1);
-      st->sections->push_back({sec, st->line});
-    }
+  std::string sec;
+  if (ini_section_header(r, &sec)) {
+    st->sections->push_back({sec, st->line});
+    if (!st->duplicates.section(sec, &why)) st->fail(why);
   }
-  if (!st->duplicates.line(r, &why)) st->fail(why);
   return r;
 }
 

@@ -58,4 +58,11 @@ std::string real_text(double v) {
   return buf;
 }
 
+std::string ini_option_line(const char* key, const std::string& value, const char* unit, const std::string& range,
+                            const char* doc) {
+  std::string line = std::string(key) + " = " + value;
+  if (line.size() < 40U) line.resize(40U, ' ');
+  return line + " ; " + (unit[0] != '\0' ? std::string(unit) + ", " : std::string()) + range + ": " + doc + "\n";
+}
+
 }  // namespace sdpslam::slam

@@ -55,14 +55,19 @@ std::string locate_option_error(const std::string& path, const std::string& why)
 // read error: see std::ferror). num >= 2.
 char* read_ini_line(std::FILE* stream, char* str, int num, std::string* why);
 
+// True, with the section's name (blanks around it trimmed), when `line` is a section
+// header "[name]" (blanks before '[' allowed); false for every other line, a header
+// without its ']' included (inih refuses that line).
+bool ini_section_header(const char* line, std::string* section);
+
 // A section given twice, or a key given twice in one section, makes a file mean what its
 // last occurrence says, which nobody reading the first one expects: every INI reader
-// refuses both. Feed it each line as read (for section headers, which the packaged inih
-// does not hand to handlers) and each key as handled.
+// refuses both. Feed it each section header as read (the packaged inih does not hand
+// headers to handlers) and each key as handled.
 class IniDuplicates {
  public:
-  // False, with `why`, when `line` is a header of a section already opened.
-  bool line(const char* line, std::string* why);
+  // False, with `why`, when `section` was already opened (see ini_section_header).
+  bool section(const std::string& section, std::string* why);
   // False, with `why`, when `name` was already given in `section`.
   bool key(const char* section, const char* name, std::string* why);
 

@@ -115,6 +115,11 @@ std::string option_range_text(const OptionSpec<Options>& spec) {
 // Every row of `table` as INI text, a section header before each new section: the
 // effective configuration (`sdpslam run --print-config`), readable back as a file.
 //   key = value   ; unit, range: doc
+//
+// One line of that text (also the daemon's own keys, firmware-host/daemon_config).
+std::string ini_option_line(const char* key, const std::string& value, const char* unit, const std::string& range,
+                            const char* doc);
+
 template <class Options>
 std::string options_ini_text(const OptionTable<Options>& table, const Options& options) {
   std::string out;
@@ -124,10 +129,7 @@ std::string options_ini_text(const OptionTable<Options>& table, const Options& o
       section = row.section;
       out += (out.empty() ? "[" : "\n[") + std::string(section) + "]\n";
     }
-    std::string line = std::string(row.key) + " = " + option_text(row, options);
-    if (line.size() < 40U) line.resize(40U, ' ');
-    out += line + " ; " + (row.unit[0] != '\0' ? std::string(row.unit) + ", " : std::string()) +
-           option_range_text(row) + ": " + row.doc + "\n";
+    out += ini_option_line(row.key, option_text(row, options), row.unit, option_range_text(row), row.doc);
   }
   return out;
 }
