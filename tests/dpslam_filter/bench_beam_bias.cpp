@@ -37,35 +37,6 @@ struct Case {
   bool every_viewpoint;
 };
 
-std::vector<test::Segment> corridor(bool doors, double heading_rad, double length_m) {
-  std::vector<test::Segment> w;
-  const double c = std::cos(heading_rad);
-  const double s = std::sin(heading_rad);
-  auto add = [&](double x0, double y0, double x1, double y1) {
-    w.push_back({x0 * c - y0 * s, x0 * s + y0 * c, x1 * c - y1 * s, x1 * s + y1 * c});
-  };
-  const double half = 1.5;
-  if (!doors) {
-    add(-2.0, -half, length_m, -half);
-    add(-2.0, half, length_m, half);
-  } else {
-    // A 1 m recess (0.5 m deep) on the right and a 1 m recess (0.4 m deep) on the left every 3 m.
-    for (double x = -2.0; x < length_m; x += 3.0) {
-      add(x, -half, x + 2.0, -half);
-      add(x + 2.0, -half, x + 2.0, -half - 0.5);
-      add(x + 2.0, -half - 0.5, x + 3.0, -half - 0.5);
-      add(x + 3.0, -half - 0.5, x + 3.0, -half);
-      add(x + 1.0, half, x + 3.0, half);
-      add(x + 1.0, half, x + 1.0, half + 0.4);
-      add(x, half + 0.4, x + 1.0, half + 0.4);
-      add(x, half + 0.4, x, half);
-    }
-  }
-  add(length_m, -half - 1.0, length_m, half + 1.0);
-  add(-2.0, -half - 1.0, -2.0, half + 1.0);
-  return w;
-}
-
 struct Result {
   double mean_m = 0.0;
   double mean_abs_m = 0.0;
@@ -74,7 +45,7 @@ struct Result {
 
 bool run_case(const Case& k, Result* out) {
   constexpr double kLength = 60.0;
-  const std::vector<test::Segment> world = corridor(k.doors, k.heading_rad, kLength);
+  const std::vector<test::Segment> world = test::corridor_world(k.doors, k.heading_rad, kLength);
   DpMap::Options mo;
   mo.origin_x_m = -10.0;
   mo.origin_y_m = -10.0;

@@ -33,6 +33,37 @@ inline std::vector<Segment> room_world() {
   return s;
 }
 
+// A straight corridor 3 m wide along x from -2 m to length_m, turned by heading_rad
+// about the origin, closed at both ends: plain walls, or walls with a door recess every
+// 3 m on each side (1 m wide, 0.5 m deep on the right, 0.4 m on the left).
+inline std::vector<Segment> corridor_world(bool doors, double heading_rad, double length_m) {
+  std::vector<Segment> w;
+  const double c = std::cos(heading_rad);
+  const double s = std::sin(heading_rad);
+  auto add = [&](double x0, double y0, double x1, double y1) {
+    w.push_back({x0 * c - y0 * s, x0 * s + y0 * c, x1 * c - y1 * s, x1 * s + y1 * c});
+  };
+  const double half = 1.5;
+  if (!doors) {
+    add(-2.0, -half, length_m, -half);
+    add(-2.0, half, length_m, half);
+  } else {
+    for (double x = -2.0; x < length_m; x += 3.0) {
+      add(x, -half, x + 2.0, -half);
+      add(x + 2.0, -half, x + 2.0, -half - 0.5);
+      add(x + 2.0, -half - 0.5, x + 3.0, -half - 0.5);
+      add(x + 3.0, -half - 0.5, x + 3.0, -half);
+      add(x + 1.0, half, x + 3.0, half);
+      add(x + 1.0, half, x + 1.0, half + 0.4);
+      add(x, half + 0.4, x + 1.0, half + 0.4);
+      add(x, half + 0.4, x, half);
+    }
+  }
+  add(length_m, -half - 1.0, length_m, half + 1.0);
+  add(-2.0, -half - 1.0, -2.0, half + 1.0);
+  return w;
+}
+
 inline double cast_ray(const std::vector<Segment>& world, double ox, double oy, double dx, double dy, double max_m) {
   double best = max_m;
   for (const Segment& g : world) {
