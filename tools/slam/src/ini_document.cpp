@@ -3,7 +3,6 @@
 #include <ini.h>
 
 #include <cctype>
-#include <cstring>
 
 #include "sdpslam/slam/config_ini.h"
 
