@@ -2,7 +2,7 @@
 // down a corridor it drove with PERFECT odometry. A plain program (not a test) that
 // prints figures; build it in a Release directory:
 //   cmake --build --preset host-release --target bench_corridor_travel
-//   build/host-release/tests/dpslam_filter/bench_corridor_travel [SEEDS]
+//   build/host-release/tests/dpslam_filter/bench_corridor_travel [SEEDS] [section.key=value ...]
 //
 // The robot drives 60 m straight down a 3 m corridor (sim_world.h corridor_world: plain
 // walls, or a door recess every 3 m) whose end walls stay out of its 30 m laser's
@@ -13,9 +13,14 @@
 // An unbiased filter scatters around 0 %; a negative mean is a filter that shortens
 // paths (the observation model prefers poses behind the true one: bench_beam_bias), and
 // with no translation noise the odometry, here exact, leaves it nothing to shorten.
+// Each section.key=value (a key of DpSlamOptions::table(), as in the INI files, e.g.
+// observation.likelihood_temperature=5) is set on every row's options after the row's
+// own, so that one option's share of the error can be measured.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include "filter_harness.h"
@@ -26,6 +31,42 @@ using namespace sdpslam;
 
 constexpr double kTravel_m = 60.0;
 constexpr double kOdometryStep_m = 0.1;
+
+// One section.key=value: the row and its value as text.
+struct Override {
+  const OptionSpec<DpSlamOptions>* row;
+  std::string value;
+};
+
+// Sets `o`'s field from text; false if the text is not a value of the row's kind or the
+// options are then invalid.
+bool apply(const Override& v, DpSlamOptions* o) {
+  const char* text = v.value.c_str();
+  char* end = nullptr;
+  switch (v.row->kind) {
+    case OptionKind::kReal: option_field<double>(*v.row, *o) = std::strtod(text, &end); break;
+    case OptionKind::kF32: option_field<float>(*v.row, *o) = std::strtof(text, &end); break;
+    case OptionKind::kU32:
+      option_field<std::uint32_t>(*v.row, *o) = static_cast<std::uint32_t>(std::strtoul(text, &end, 10));
+      break;
+    case OptionKind::kBool:
+      if (v.value != "true" && v.value != "false") return false;
+      option_field<bool>(*v.row, *o) = v.value == "true";
+      end = const_cast<char*>(text) + v.value.size();
+      break;
+    case OptionKind::kChoice:
+      for (std::uint8_t i = 0; i < v.row->choice_count; ++i) {
+        if (v.value == v.row->choices[i].name) {
+          option_field<std::uint8_t>(*v.row, *o) = v.row->choices[i].value;
+          end = const_cast<char*>(text) + v.value.size();
+        }
+      }
+      break;
+  }
+  return end != nullptr && end != text && *end == '\0' && o->validate(nullptr, 0U);
+}
+
+std::vector<Override> g_overrides;
 
 struct Row {
   bool doors;
@@ -47,6 +88,9 @@ double travel_m(const Row& row, std::uint64_t seed) {
     o.motion.min_sigma_trans_m = 0.0;
   }
   if (row.scan_match) o.proposal = DpSlamOptions::Proposal::kScanMatch;
+  for (const Override& v : g_overrides) {
+    if (!apply(v, &o)) return std::nan("");
+  }
   test::FilterRig rig;
   if (!rig.init(o, seed)) return std::nan("");
   const std::vector<test::Segment> world = test::corridor_world(row.doors, 0.0, kTravel_m + 40.0);
@@ -63,8 +107,24 @@ double travel_m(const Row& row, std::uint64_t seed) {
 int main(int argc, char** argv) {
   const long seeds = argc > 1 ? std::strtol(argv[1], nullptr, 10) : 20L;
   if (seeds < 1 || seeds > 1000) {
-    std::fprintf(stderr, "usage: bench_corridor_travel [SEEDS: 1 .. 1000, default 20]\n");
+    std::fprintf(stderr, "usage: bench_corridor_travel [SEEDS: 1 .. 1000, default 20] [section.key=value ...]\n");
     return 2;
+  }
+  for (int i = 2; i < argc; ++i) {
+    const char* dot = std::strchr(argv[i], '.');
+    const char* eq = std::strchr(argv[i], '=');
+    const OptionSpec<DpSlamOptions>* row =
+        dot != nullptr && eq != nullptr && dot < eq
+            ? DpSlamOptions::table().find(std::string(argv[i], static_cast<std::size_t>(dot - argv[i])).c_str(),
+                                          std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
+            : nullptr;
+    DpSlamOptions check = test::sim_options(10U);
+    if (row == nullptr || !apply(Override{row, eq + 1}, &check)) {
+      std::fprintf(stderr, "bench_corridor_travel: '%s' is not section.key=value of a valid [filter] option\n", argv[i]);
+      return 2;
+    }
+    g_overrides.push_back(Override{row, eq + 1});
+    std::printf("with %s\n", argv[i]);
   }
   std::printf("| walls | proposal | translation noise | mean travel error | worst seed | seeds |\n");
   std::printf("|---|---|---|---|---|---|\n");
