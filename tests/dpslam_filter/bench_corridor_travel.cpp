@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "filter_harness.h"
+#include "sdpslam/slam/option_text.h"
 
 namespace {
 
@@ -38,32 +39,13 @@ struct Override {
   std::string value;
 };
 
-// Sets `o`'s field from text; false if the text is not a value of the row's kind or the
-// options are then invalid.
-bool apply(const Override& v, DpSlamOptions* o) {
-  const char* text = v.value.c_str();
-  char* end = nullptr;
-  switch (v.row->kind) {
-    case OptionKind::kReal: option_field<double>(*v.row, *o) = std::strtod(text, &end); break;
-    case OptionKind::kF32: option_field<float>(*v.row, *o) = std::strtof(text, &end); break;
-    case OptionKind::kU32:
-      option_field<std::uint32_t>(*v.row, *o) = static_cast<std::uint32_t>(std::strtoul(text, &end, 10));
-      break;
-    case OptionKind::kBool:
-      if (v.value != "true" && v.value != "false") return false;
-      option_field<bool>(*v.row, *o) = v.value == "true";
-      end = const_cast<char*>(text) + v.value.size();
-      break;
-    case OptionKind::kChoice:
-      for (std::uint8_t i = 0; i < v.row->choice_count; ++i) {
-        if (v.value == v.row->choices[i].name) {
-          option_field<std::uint8_t>(*v.row, *o) = v.row->choices[i].value;
-          end = const_cast<char*>(text) + v.value.size();
-        }
-      }
-      break;
-  }
-  return end != nullptr && end != text && *end == '\0' && o->validate(nullptr, 0U);
+// Sets `o`'s field from text (the INI files' dialect, slam::set_option_text); false, with
+// *why, if the text is not a value of the row or the options are then invalid.
+bool apply(const Override& v, DpSlamOptions* o, std::string* why) {
+  if (!slam::set_option_text(*v.row, o, v.value.c_str(), why)) return false;
+  if (o->validate(nullptr, 0U)) return true;
+  *why = std::string(v.row->section) + "." + v.row->key + ": the options are then invalid";
+  return false;
 }
 
 std::vector<Override> g_overrides;
@@ -88,8 +70,9 @@ double travel_m(const Row& row, std::uint64_t seed) {
     o.motion.min_sigma_trans_m = 0.0;
   }
   if (row.scan_match) o.proposal = DpSlamOptions::Proposal::kScanMatch;
+  std::string why;
   for (const Override& v : g_overrides) {
-    if (!apply(v, &o)) return std::nan("");
+    if (!apply(v, &o, &why)) return std::nan("");
   }
   test::FilterRig rig;
   if (!rig.init(o, seed)) return std::nan("");
@@ -119,8 +102,9 @@ int main(int argc, char** argv) {
                                           std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
             : nullptr;
     DpSlamOptions check = test::sim_options(10U);
-    if (row == nullptr || !apply(Override{row, eq + 1}, &check)) {
-      std::fprintf(stderr, "bench_corridor_travel: '%s' is not section.key=value of a valid [filter] option\n", argv[i]);
+    std::string why = "not section.key=value of a [filter] option";
+    if (row == nullptr || !apply(Override{row, eq + 1}, &check, &why)) {
+      std::fprintf(stderr, "bench_corridor_travel: '%s': %s\n", argv[i], why.c_str());
       return 2;
     }
     g_overrides.push_back(Override{row, eq + 1});
