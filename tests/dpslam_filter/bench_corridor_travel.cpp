@@ -8,8 +8,11 @@
 // walls, or a door recess every 3 m) whose end walls stay out of its 30 m laser's
 // reach; scans are exact (181 beams over 180 deg). Odometry is the true motion, so the
 // filter's only errors are its own: after the run, the best particle's travel along the
-// corridor is compared with 60 m, for each seed (SEEDS, default 20). Rows: odometry or
-// scan-matching proposal, with the motion model's default translation noise or none.
+// corridor is compared with 60 m, for each seed (SEEDS, default 20). The filter is the
+// bottom level as `sdpslam run` configures it by default (DpSlamOptions with the default
+// profile, sdp_profile.h: 10 particles, scan-matching proposal), in a map large enough
+// for the corridor. Rows: odometry or scan-matching proposal, with the motion model's
+// default translation noise or none.
 // An unbiased filter scatters around 0 %; a negative mean is a filter that shortens
 // paths (the observation model prefers poses behind the true one: bench_beam_bias), and
 // with no translation noise the odometry, here exact, leaves it nothing to shorten.
@@ -24,6 +27,7 @@
 #include <vector>
 
 #include "filter_harness.h"
+#include "sdpslam/core/sdp_profile.h"
 #include "sdpslam/slam/option_text.h"
 
 namespace {
@@ -50,6 +54,13 @@ bool apply(const Override& v, DpSlamOptions* o, std::string* why) {
 
 std::vector<Override> g_overrides;
 
+// The bottom level as `sdpslam run` configures it by default (sdp_profile.h).
+DpSlamOptions product_options() {
+  DpSlamOptions o;
+  apply_profile(kDefaultSdpProfile, &o, nullptr);
+  return o;
+}
+
 struct Row {
   bool doors;
   bool scan_match;
@@ -59,7 +70,7 @@ struct Row {
 // The best particle's travel along the corridor (x) after the run, or NaN if the filter
 // could not be set up.
 double travel_m(const Row& row, std::uint64_t seed) {
-  DpSlamOptions o = test::sim_options(10U);
+  DpSlamOptions o = product_options();
   o.map_width_m = 2.0 * (kTravel_m + 10.0);  // centred on the first pose
   o.map_height_m = 20.0;
   o.map_observations_base = 3000000U;
@@ -69,7 +80,7 @@ double travel_m(const Row& row, std::uint64_t seed) {
     o.motion.alpha_trans_from_rot = 0.0;
     o.motion.min_sigma_trans_m = 0.0;
   }
-  if (row.scan_match) o.proposal = DpSlamOptions::Proposal::kScanMatch;
+  o.proposal = row.scan_match ? DpSlamOptions::Proposal::kScanMatch : DpSlamOptions::Proposal::kOdometry;
   std::string why;
   for (const Override& v : g_overrides) {
     if (!apply(v, &o, &why)) return std::nan("");
@@ -101,7 +112,7 @@ int main(int argc, char** argv) {
             ? DpSlamOptions::table().find(std::string(argv[i], static_cast<std::size_t>(dot - argv[i])).c_str(),
                                           std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
             : nullptr;
-    DpSlamOptions check = test::sim_options(10U);
+    DpSlamOptions check = product_options();
     std::string why = "not section.key=value of a [filter] option";
     if (row == nullptr || !apply(Override{row, eq + 1}, &check, &why)) {
       std::fprintf(stderr, "bench_corridor_travel: '%s': %s\n", argv[i], why.c_str());
