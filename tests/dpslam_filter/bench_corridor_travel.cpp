@@ -14,8 +14,10 @@
 // for the corridor. Rows: odometry or scan-matching proposal, with the motion model's
 // default translation noise or none.
 // An unbiased filter scatters around 0 %; a negative mean is a filter that shortens
-// paths (the observation model prefers poses behind the true one: bench_beam_bias), and
-// with no translation noise the odometry, here exact, leaves it nothing to shorten.
+// paths (the observation model prefers poses behind the true one: bench_beam_bias).
+// Without translation noise the exact odometry pins each step's length; what is left
+// comes from the heading noise (a path that wanders covers less of the corridor) and,
+// with scan matching, from the noise drawn around each match.
 // Each section.key=value (a key of DpSlamOptions::table(), as in the INI files, e.g.
 // observation.likelihood_temperature=5) is set on every row's options after the row's
 // own, so that one option's share of the error can be measured.
