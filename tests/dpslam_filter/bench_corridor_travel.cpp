@@ -46,11 +46,13 @@ struct Override {
 };
 
 // Sets `o`'s field from text (the INI files' dialect, slam::set_option_text); false, with
-// *why, if the text is not a value of the row or the options are then invalid.
+// *why, if the text is not a value of the row or the options are then invalid
+// (DpSlamOptions::validate's reason).
 bool apply(const Override& v, DpSlamOptions* o, std::string* why) {
   if (!slam::set_option_text(*v.row, o, v.value.c_str(), why)) return false;
-  if (o->validate(nullptr, 0U)) return true;
-  *why = std::string(v.row->section) + "." + v.row->key + ": the options are then invalid";
+  char reason[256] = {};
+  if (o->validate(reason, sizeof reason)) return true;
+  *why = reason;
   return false;
 }
 
