@@ -1,4 +1,4 @@
-#include "sdpslam/core/sdp_slam.h"
+#include "sdp_slam_impl.h"
 
 #include <cmath>
 #include <cstdio>
@@ -93,9 +93,9 @@ double SdpStats::error_std_m() const {
   return v > 0.0 ? det::sqrt(v) : 0.0;
 }
 
-double SdpSlam::box_overlap_m2(const double a[4], const double b[4]) { return sdpslam::box_overlap_m2(a, b); }
+double SdpSlamImpl::box_overlap_m2(const double a[4], const double b[4]) { return sdpslam::box_overlap_m2(a, b); }
 
-DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp) {
+DpSlamOptions SdpSlamImpl::bottom_options_for(const DpSlamOptions& bottom, const SdpOptions& sdp) {
   DpSlamOptions b = bottom;
   const std::uint32_t n = b.particle_count;
   // Anchored segments keep at most 2N-1 nodes each (prune bound); the restart needs N+1;
@@ -117,7 +117,7 @@ DpSlamOptions SdpSlam::bottom_options_for(const DpSlamOptions& bottom, const Sdp
   return b;
 }
 
-std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const SdpOptions& s) {
+std::size_t SdpSlamImpl::required_arena_bytes(const DpSlamOptions& bottom_in, const SdpOptions& s) {
   if (!s.validate(nullptr, 0U)) return 0U;
   const DpSlamOptions b = bottom_options_for(bottom_in, s);
   const std::size_t fb = DpSlamFilter::required_arena_bytes(b);
@@ -143,7 +143,7 @@ std::size_t SdpSlam::required_arena_bytes(const DpSlamOptions& bottom_in, const 
   return total + kSlack;
 }
 
-bool SdpSlam::check_options(const DpSlamOptions& bottom, const SdpOptions& s, char* why, std::size_t n) {
+bool SdpSlamImpl::check_options(const DpSlamOptions& bottom, const SdpOptions& s, char* why, std::size_t n) {
   if (why != nullptr && n > 0U) why[0] = '\0';
   if (!s.validate(why, n) || !bottom.validate(why, n)) return false;
   const DpSlamOptions b = bottom_options_for(bottom, s);
@@ -182,7 +182,7 @@ bool SdpSlam::check_options(const DpSlamOptions& bottom, const SdpOptions& s, ch
   return true;
 }
 
-bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& arena, std::uint64_t seed) {
+bool SdpSlamImpl::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& arena, std::uint64_t seed) {
   initialised_ = false;
   if (!check_options(bottom_in, s, why_, sizeof why_)) return false;
   const DpSlamOptions b = bottom_options_for(bottom_in, s);
@@ -284,7 +284,7 @@ bool SdpSlam::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Arena& a
   return true;
 }
 
-void SdpSlam::ring_push(std::int64_t stamp_us, const Pose2& pose) {
+void SdpSlamImpl::ring_push(std::int64_t stamp_us, const Pose2& pose) {
   if (!ring_.push(stamp_us, pose)) {
     ++stats_.pose_ring_dropped;
     return;
@@ -292,7 +292,7 @@ void SdpSlam::ring_push(std::int64_t stamp_us, const Pose2& pose) {
   if (ring_.size() > stats_.pose_ring_peak) stats_.pose_ring_peak = ring_.size();
 }
 
-bool SdpSlam::global_map_grid(GlobalMapGrid* grid) const {
+bool SdpSlamImpl::global_map_grid(GlobalMapGrid* grid) const {
   *grid = GlobalMapGrid{};
   if (!initialised_) return false;
   const DpMap& map = filter_->map();
@@ -335,18 +335,18 @@ bool SdpSlam::global_map_grid(GlobalMapGrid* grid) const {
   return true;
 }
 
-void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
+void SdpSlamImpl::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
   top_.error_summary(mean_m, std_m, count);
 }
 
 // ---- per scan -------------------------------------------------------------------------
 
-bool SdpSlam::relocate(const Pose2& delta) {
+bool SdpSlamImpl::relocate(const Pose2& delta) {
   if (!initialised_ || !started_) return false;
   return filter_->displace(delta);
 }
 
-SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan) {
+SdpStepResult SdpSlamImpl::process(const OdometrySample& odom, const RangeScan& scan) {
   SdpStepResult result;
   if (!initialised_) return result;
   const std::uint64_t requested_before = filter_->map().observations_requested();
@@ -424,7 +424,7 @@ SdpStepResult SdpSlam::process(const OdometrySample& odom, const RangeScan& scan
   return result;
 }
 
-void SdpSlam::finish() {
+void SdpSlamImpl::finish() {
   if (!initialised_) return;
   while (do_work(0xFFFFFFFFU) > 0U) {
   }
@@ -432,7 +432,7 @@ void SdpSlam::finish() {
 
 // ---- segmentation, anchorage, restart (lines 4-8) --------------------------------------
 
-void SdpSlam::segment(std::int64_t stamp_us) {
+void SdpSlamImpl::segment(std::int64_t stamp_us) {
   const std::uint32_t n = filter_->particle_count();
   // Room in the PGS first (bounded memory): the oldest level becomes permanent.
   if (graph_.live_level_count() >= options_.max_levels) make_oldest_permanent();
@@ -529,14 +529,14 @@ void SdpSlam::segment(std::int64_t stamp_us) {
 // particles would then weigh scans against a map with holes. When the pool has room,
 // nothing changes: releases stay spread over scans. Checked before the restart and
 // again once the ended segment is a level (which may then go too).
-std::uint64_t SdpSlam::observations_needed() const {
+std::uint64_t SdpSlamImpl::observations_needed() const {
   const DpMap& map = filter_->map();
   const std::uint64_t grown_to = std::uint64_t{map.observations_used()} + (observations_released_ - segment_observations_released_);
   const std::uint64_t grown = grown_to > segment_observations_used_ ? grown_to - segment_observations_used_ : 0U;
   return grown + (map.observation_oom_count() - segment_observations_refused_) + scan_burst();
 }
 
-void SdpSlam::make_room(std::uint64_t need) {
+void SdpSlamImpl::make_room(std::uint64_t need) {
   const DpMap& map = filter_->map();
   auto short_of_room = [&] {
     return std::uint64_t{map.observations_used()} + need > std::uint64_t{map.observation_capacity()};
@@ -552,17 +552,17 @@ void SdpSlam::make_room(std::uint64_t need) {
   }
 }
 
-std::uint64_t SdpSlam::scan_burst() const {
+std::uint64_t SdpSlamImpl::scan_burst() const {
   return scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
 }
 
 // The pending releases and the permanent submap's copy, all now.
-void SdpSlam::finish_releases() {
+void SdpSlamImpl::finish_releases() {
   while (release_count_ > 0U) release_one();
   while (transfer_.active()) transfer_step(0xFFFFFFFFU);
 }
 
-void SdpSlam::make_oldest_permanent() {
+void SdpSlamImpl::make_oldest_permanent() {
   const std::uint32_t level = graph_.first_live_level();
   if (!graph_.is_live(level)) return;
   // Pending work first (the previous level's releases and transfer, this level's skeletons).
@@ -602,7 +602,7 @@ void SdpSlam::make_oldest_permanent() {
 }
 
 // The permanent submap's copy into the global map (map_transfer.h), within the budget.
-std::uint32_t SdpSlam::transfer_step(std::uint32_t budget_cells) {
+std::uint32_t SdpSlamImpl::transfer_step(std::uint32_t budget_cells) {
   const TransferStep st = transfer_.work(budget_cells, *filter_, permanent_map_, fine_buffer());
   stats_.map_transfer_cells += st.cells_copied;
   stats_.map_transfer_dropped += st.cells_dropped;
@@ -613,7 +613,7 @@ std::uint32_t SdpSlam::transfer_step(std::uint32_t budget_cells) {
   return st.work_cells;
 }
 
-std::uint32_t SdpSlam::release_one() {
+std::uint32_t SdpSlamImpl::release_one() {
   if (release_count_ == 0U) return 0U;
   const NodeId node = release_queue_[--release_count_];
   const std::uint32_t held = filter_->map().observations_used();
@@ -623,7 +623,7 @@ std::uint32_t SdpSlam::release_one() {
   return 1U;
 }
 
-std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
+std::uint32_t SdpSlamImpl::do_work(std::uint32_t budget_cells) {
   std::uint32_t used = release_one();
   // The permanent submap's copy into the global map first, in strips within the budget:
   // its observations (and the tiles only it holds) are freed when it completes, and the
@@ -645,7 +645,7 @@ std::uint32_t SdpSlam::do_work(std::uint32_t budget_cells) {
 }
 
 // A submap's skeleton in slices (skeleton_reader.h), one job at a time.
-std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node) {
+std::uint32_t SdpSlamImpl::extract_skeleton(std::uint32_t level, std::uint32_t node) {
   if (!skeletons_.is_job(level, node)) {
     while (skeletons_.active()) skeleton_step(0xFFFFFFFFU);
     skeletons_.start(store_, level, node);
@@ -655,7 +655,7 @@ std::uint32_t SdpSlam::extract_skeleton(std::uint32_t level, std::uint32_t node)
   return used;
 }
 
-std::uint32_t SdpSlam::skeleton_step(std::uint32_t budget_cells) {
+std::uint32_t SdpSlamImpl::skeleton_step(std::uint32_t budget_cells) {
   const SkeletonStep st = skeletons_.work(budget_cells, *filter_, store_, fine_buffer());
   if (st.extracted) {
     ++stats_.skeletons;
@@ -669,7 +669,7 @@ std::uint32_t SdpSlam::skeleton_step(std::uint32_t budget_cells) {
 // Ranking, elitism, diversification and extension are TopParticles' (top_particles.h);
 // here a combination is evaluated, and each round's outcome published.
 
-void SdpSlam::evaluate(std::uint32_t p) {
+void SdpSlamImpl::evaluate(std::uint32_t p) {
   ++stats_.evaluations;
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
@@ -717,7 +717,7 @@ void SdpSlam::evaluate(std::uint32_t p) {
   if (hi > lo) graph_.record_chain_error(lo, chain_ + (lo - first), hi - lo + 1U, err);
 }
 
-void SdpSlam::end_round(std::int64_t stamp_us, bool may_continue) {
+void SdpSlamImpl::end_round(std::int64_t stamp_us, bool may_continue) {
   round_active_ = false;
   ++stats_.rounds;
   ++rounds_in_segment_;
@@ -741,7 +741,7 @@ void SdpSlam::end_round(std::int64_t stamp_us, bool may_continue) {
   }
 }
 
-void SdpSlam::update_best() {
+void SdpSlamImpl::update_best() {
   best_top_ = top_.rank();
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
@@ -759,7 +759,7 @@ void SdpSlam::update_best() {
 
 // ---- loop closure (beyond the paper; see the header) ------------------------------------
 
-void SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
+void SdpSlamImpl::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
   const DpMap& map = filter_->map();
   const double half = 0.5 * map.resolution_m();
   const double ox = map.options().origin_x_m;
@@ -774,7 +774,7 @@ void SdpSlam::unpack(const CellPoint* in, std::uint32_t n, Point2* out) const {
 // submaps of a level share the level's frame (the bottom particles restarted at one
 // pose in the map's grid frame), so a constraint between two levels' frames measured
 // with some of their submaps holds for the chosen ones too.
-bool SdpSlam::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const {
+bool SdpSlamImpl::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const {
   std::uint32_t pi = 0U;
   if (store_.find_permanent(level, &pi)) {
     *stamp_us = store_.permanent(pi).start_stamp_us;
@@ -788,7 +788,7 @@ bool SdpSlam::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* i
   return true;
 }
 
-bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
+bool SdpSlamImpl::graph_index(std::uint32_t level, std::uint32_t* index) const {
   std::uint32_t pi = 0U;
   if (store_.find_permanent(level, &pi)) {
     *index = level - store_.first_held_level(level);
@@ -803,7 +803,7 @@ bool SdpSlam::graph_index(std::uint32_t level, std::uint32_t* index) const {
 // The best combination's frames as a pose graph (frame_graph.h): permanent submaps held
 // (oldest fixed), then the chosen live submaps (frames_ on entry: the composed chain),
 // chain constraints T between consecutive ones, loop constraints between any two.
-void SdpSlam::adjust_frames() {
+void SdpSlamImpl::adjust_frames() {
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();
   FrameGraph& g = loop_closure_.begin_adjustment();
@@ -843,7 +843,7 @@ void SdpSlam::adjust_frames() {
 
 // ---- the submaps as loop closure sees them (loop_closure.h) ----------------------------
 
-bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
+bool SdpSlamImpl::level_obstacles(std::uint32_t level, const CellPoint** points, std::uint32_t* count, Pose2* frame,
                               double box[4]) const {
   std::uint32_t pi = 0U;
   if (store_.find_permanent(level, &pi)) {
@@ -866,16 +866,16 @@ bool SdpSlam::level_obstacles(std::uint32_t level, const CellPoint** points, std
   return true;
 }
 
-std::uint32_t SdpSlam::first_held_level() const {
+std::uint32_t SdpSlamImpl::first_held_level() const {
   return store_.first_held_level(graph_.first_live_level());
 }
 
-bool SdpSlam::placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const {
+bool SdpSlamImpl::placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* obstacle_count) const {
   const CellPoint* points = nullptr;
   return level_obstacles(level, &points, obstacle_count, frame, box);
 }
 
-void SdpSlam::obstacles(std::uint32_t level, Point2* out) const {
+void SdpSlamImpl::obstacles(std::uint32_t level, Point2* out) const {
   const CellPoint* points = nullptr;
   std::uint32_t n = 0U;
   Pose2 frame;

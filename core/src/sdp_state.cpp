@@ -1,4 +1,4 @@
-// SdpSlam snapshots: the whole engine state as a stream (core/state_io.h).
+// SdpSlamImpl snapshots: the whole engine state as a stream (core/state_io.h).
 //
 // Layout of the stream:
 //   header     tag, format, build fingerprint (the sizes of the engine's objects and the
@@ -6,13 +6,13 @@
 //              three engine objects sit in it;
 //   region     the region's bytes, less the three objects' (they hold pointers and
 //              vtable pointers, which stay as this process's init() set them);
-//   members    SdpSlam's, then each part's own (transfer_state), with a tag per part;
+//   members    SdpSlamImpl's, then each part's own (transfer_state), with a tag per part;
 //   end tag.
 // Reading compares the header with this engine before it writes anything, so that a
 // stream of another build or other options changes nothing and says why.
 #include <cstdio>
 
-#include "sdpslam/core/sdp_slam.h"
+#include "sdp_slam_impl.h"
 
 namespace sdpslam {
 namespace {
@@ -23,7 +23,7 @@ constexpr std::uint32_t kStateFormat = 1U;
 struct Fingerprint {
   std::uint32_t byte_order = 0x01020304U;
   std::uint32_t pointer_bytes = static_cast<std::uint32_t>(sizeof(void*));
-  std::uint64_t engine_bytes = sizeof(SdpSlam);
+  std::uint64_t engine_bytes = sizeof(SdpSlamImpl);
   std::uint64_t filter_bytes = sizeof(DpSlamFilter);
   std::uint64_t icp_bytes = sizeof(Icp2d);
   std::uint64_t segmenter_bytes = sizeof(Segmenter);
@@ -44,18 +44,18 @@ struct Hole {
 
 }  // namespace
 
-std::uint64_t SdpSlam::state_bytes() const {
+std::uint64_t SdpSlamImpl::state_bytes() const {
   if (!initialised_) return 0U;
   struct Counter final : StateWriter {
     bool write(const void*, std::size_t) override { return true; }
   } counter;
   // save_state() is const in effect; transfer_state() shares code with loading.
   StateIo io(counter, state_begin_, static_cast<std::size_t>(state_end_ - state_begin_));
-  const_cast<SdpSlam*>(this)->transfer_state(io);
+  const_cast<SdpSlamImpl*>(this)->transfer_state(io);
   return io.ok() ? io.byte_count() : 0U;
 }
 
-bool SdpSlam::save_state(StateWriter& writer) {
+bool SdpSlamImpl::save_state(StateWriter& writer) {
   if (!initialised_) {
     std::snprintf(why_, sizeof why_, "snapshot: engine not initialised");
     return false;
@@ -69,7 +69,7 @@ bool SdpSlam::save_state(StateWriter& writer) {
   return true;
 }
 
-bool SdpSlam::load_state(StateReader& reader) {
+bool SdpSlamImpl::load_state(StateReader& reader) {
   if (!initialised_) {
     std::snprintf(why_, sizeof why_, "snapshot: engine not initialised");
     return false;
@@ -86,7 +86,7 @@ bool SdpSlam::load_state(StateReader& reader) {
   return true;
 }
 
-void SdpSlam::transfer_state(StateIo& io) {
+void SdpSlamImpl::transfer_state(StateIo& io) {
   // ---- header
   io.section("sdpslam state");
   std::uint32_t format = kStateFormat;

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/pose_ring.h"
+#include "pose_ring.h"
 
 using sdpslam::Arena;
 using sdpslam::PoseRing;

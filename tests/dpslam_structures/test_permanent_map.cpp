@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/permanent_map.h"
+#include "top/permanent_map.h"
 
 using sdpslam::Arena;
 using sdpslam::PermanentMap;

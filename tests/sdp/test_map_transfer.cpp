@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "../dpslam_filter/filter_harness.h"
-#include "sdpslam/core/top/map_transfer.h"
-#include "sdpslam/core/top/permanent_map.h"
+#include "top/map_transfer.h"
+#include "top/permanent_map.h"
 
 using namespace sdpslam;
 

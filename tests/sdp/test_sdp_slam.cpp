@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "sdp_harness.h"
+#include "top/permanent_map.h"
+#include "top/segment_graph.h"
 
 using namespace sdpslam;
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sdp_harness.h"
+#include "top/segment_graph.h"
 
 using namespace sdpslam;
 

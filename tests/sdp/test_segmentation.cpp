@@ -3,7 +3,7 @@
 
 #include <cstring>
 
-#include "sdpslam/core/top/segmentation.h"
+#include "top/segmentation.h"
 
 using namespace sdpslam;
 

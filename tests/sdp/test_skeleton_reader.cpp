@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "../dpslam_filter/filter_harness.h"
-#include "sdpslam/core/top/skeleton_reader.h"
-#include "sdpslam/core/top/submap_store.h"
+#include "top/skeleton_reader.h"
+#include "top/submap_store.h"
 
 using namespace sdpslam;
 

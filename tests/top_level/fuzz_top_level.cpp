@@ -9,9 +9,9 @@
 #include <cstring>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
-#include "sdpslam/core/top/segment_graph.h"
+#include "top/segment_graph.h"
 
 namespace {
 

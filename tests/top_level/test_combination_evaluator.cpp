@@ -6,8 +6,8 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/box2.h"
-#include "sdpslam/core/top/combination_evaluator.h"
-#include "sdpslam/core/top/submap_store.h"
+#include "top/combination_evaluator.h"
+#include "top/submap_store.h"
 #include "top_level_fixtures.h"
 
 using sdpslam::Arena;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "CppUTest/TestHarness.h"
-#include "sdpslam/core/loops/frame_graph.h"
+#include "loops/frame_graph.h"
 
 using namespace sdpslam;
 

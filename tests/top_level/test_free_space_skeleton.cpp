@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 #include "top_level_fixtures.h"
 
 using sdpslam::CellState;

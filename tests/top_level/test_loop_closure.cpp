@@ -12,7 +12,7 @@
 
 #include "CppUTest/TestHarness.h"
 #include "sdpslam/core/box2.h"
-#include "sdpslam/core/loops/loop_closure.h"
+#include "loops/loop_closure.h"
 #include "sdpslam/core/sdp_profile.h"
 
 using namespace sdpslam;

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/segment_graph.h"
+#include "top/segment_graph.h"
 #include "top_level_fixtures.h"
 
 using sdpslam::PgsAccumulation;

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "top_level_fixtures.h"
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/submap_store.h"
+#include "top/submap_store.h"
 
 using sdpslam::Arena;
 using sdpslam::CellPoint;

@@ -5,10 +5,10 @@
 
 #include "alloc_counter.h"
 #include "sdpslam/core/arena.h"
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
-#include "sdpslam/core/top/segment_graph.h"
-#include "sdpslam/core/top/top_particles.h"
+#include "top/segment_graph.h"
+#include "top/top_particles.h"
 #include "top_level_fixtures.h"
 
 namespace {

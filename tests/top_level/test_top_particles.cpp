@@ -7,8 +7,8 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/rng.h"
-#include "sdpslam/core/top/segment_graph.h"
-#include "sdpslam/core/top/top_particles.h"
+#include "top/segment_graph.h"
+#include "top/top_particles.h"
 
 using sdpslam::Arena;
 using sdpslam::PgsNodeInput;

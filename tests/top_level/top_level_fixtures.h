@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 

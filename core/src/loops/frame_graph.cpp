@@ -1,4 +1,4 @@
-#include "sdpslam/core/loops/frame_graph.h"
+#include "loops/frame_graph.h"
 
 #include "sdpslam/core/det_math.h"
 

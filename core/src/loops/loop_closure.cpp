@@ -1,4 +1,4 @@
-#include "sdpslam/core/loops/loop_closure.h"
+#include "loops/loop_closure.h"
 
 #include "sdpslam/core/box2.h"
 #include "sdpslam/core/det_math.h"

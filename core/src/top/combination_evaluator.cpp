@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/combination_evaluator.h"
+#include "top/combination_evaluator.h"
 
 #include <cstring>
 

@@ -1,5 +1,5 @@
 // Medial axis of the free space of a grid patch; see free_space_skeleton.h.
-#include "sdpslam/core/top/free_space_skeleton.h"
+#include "top/free_space_skeleton.h"
 
 #include <limits>
 

@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/map_transfer.h"
+#include "top/map_transfer.h"
 
 #include <cmath>
 

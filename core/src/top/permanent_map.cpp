@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/permanent_map.h"
+#include "top/permanent_map.h"
 
 namespace sdpslam {
 

@@ -1,5 +1,5 @@
 // Probabilistic Graph of Segments; see segment_graph.h for the contract.
-#include "sdpslam/core/top/segment_graph.h"
+#include "top/segment_graph.h"
 
 #include <limits>
 

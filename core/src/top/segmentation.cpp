@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/segmentation.h"
+#include "top/segmentation.h"
 
 #include "sdpslam/core/det_math.h"
 

@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/skeleton_reader.h"
+#include "top/skeleton_reader.h"
 
 #include "sdpslam/core/box2.h"
 

@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/submap_store.h"
+#include "top/submap_store.h"
 
 namespace sdpslam {
 

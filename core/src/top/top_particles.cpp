@@ -1,4 +1,4 @@
-#include "sdpslam/core/top/top_particles.h"
+#include "top/top_particles.h"
 
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/det_math.h"

@@ -190,7 +190,6 @@ std::string sdp_loops_tsv(const SdpSlam& slam) {
   std::string out =
       "# sdpslam loop constraints: older newer source used error_m z_x z_y z_theta older_stamp older_x older_y "
       "older_theta newer_stamp newer_x newer_y newer_theta (s, m, rad)\n";
-  const LoopClosure& loops = slam.loop_closure();
   auto origin = [&slam](std::uint32_t level) {
     std::int64_t stamp_us = 0;
     Pose2 p;
@@ -200,8 +199,8 @@ std::string sdp_loops_tsv(const SdpSlam& slam) {
                   p.heading_rad);
     return std::string(text);
   };
-  for (std::uint32_t k = 0; k < loops.record_count(); ++k) {
-    const LoopClosure::Record& r = loops.record(k);
+  for (std::uint32_t k = 0; k < slam.loop_record_count(); ++k) {
+    const SdpLoopRecord r = slam.loop_record(k);
     const bool used = slam.level_held(r.older_level) && slam.level_held(r.newer_level);
     char line[200];
     std::snprintf(line, sizeof line, "%u %u %s %d %.6f %.6f %.6f %.9f ", r.older_level, r.newer_level,
@@ -217,7 +216,7 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
   const DpMap& map = bottom.map();
   const DpSlamStats& bs = bottom.stats();
   const SdpStats& st = slam.stats();
-  const SegmentGraph& g = slam.graph();
+  const SdpPools sp = slam.pools();
   const SdpOptions& so = slam.options();
   auto fixed = [](double v, int decimals) { return io::json_fixed(v, decimals); };
   io::Json js;
@@ -267,19 +266,18 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                           {"recentred", st.loop_search_recentred},
                           {"recentred_closed", st.loop_search_recentred_closed}}}};
   io::Json pools = filter_pools_json(bottom);
-  pools["pgs_levels"] = {{"capacity", so.max_levels}, {"peak", g.peak_levels_used()}, {"refused", st.pgs_refused}};
+  pools["pgs_levels"] = {{"capacity", so.max_levels}, {"peak", sp.pgs_levels_peak}, {"refused", st.pgs_refused}};
   pools["permanent_submaps"] = {{"capacity", so.max_permanent_submaps},
-                                {"used", slam.permanent_submap_count()},
+                                {"used", sp.permanent_submaps},
                                 {"forgotten", st.permanent_forgotten}};
-  const PermanentMap& pmap = slam.permanent_map();
-  pools["permanent_map_tiles"] = {{"capacity", pmap.tile_capacity()},
-                                  {"used", pmap.tiles_used()},
-                                  {"known_cells", pmap.known_cells()},
-                                  {"compactions", pmap.compactions()},
+  pools["permanent_map_tiles"] = {{"capacity", sp.permanent_map_tile_capacity},
+                                  {"used", sp.permanent_map_tiles_used},
+                                  {"known_cells", sp.permanent_map_known_cells},
+                                  {"compactions", sp.permanent_map_compactions},
                                   {"cell_m", fixed(bottom.map().resolution_m() *
-                                                       static_cast<double>(std::uint64_t{1} << pmap.scale_log2()), 3)},
-                                  {"exhausted", pmap.refused_no_tile()}};
-  pools["pose_ring"] = {{"capacity", slam.pose_ring_capacity()},
+                                                       static_cast<double>(std::uint64_t{1} << sp.permanent_map_scale_log2), 3)},
+                                  {"exhausted", sp.permanent_map_refused}};
+  pools["pose_ring"] = {{"capacity", sp.pose_ring_capacity},
                         {"peak", st.pose_ring_peak},
                         {"dropped", st.pose_ring_dropped}};
   pools["map_updates_dropped"] = bs.map_updates_dropped;

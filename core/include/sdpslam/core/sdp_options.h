@@ -9,9 +9,11 @@
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/option_table.h"
 #include "sdpslam/core/top/icp2d.h"
-#include "sdpslam/core/top/segment_graph.h"
 
 namespace sdpslam {
+
+// How a PGS edge folds the errors of the samples that crossed it (segment_graph.h).
+enum class PgsAccumulation : std::uint8_t { kSum, kMean };
 
 // Line 4, "segmentation decision": the paper tested both.
 enum class SegmentationMode : std::uint8_t {

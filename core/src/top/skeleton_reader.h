@@ -25,8 +25,8 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/state_io.h"
-#include "sdpslam/core/top/free_space_skeleton.h"
-#include "sdpslam/core/top/submap_store.h"
+#include "top/free_space_skeleton.h"
+#include "top/submap_store.h"
 
 namespace sdpslam {
 

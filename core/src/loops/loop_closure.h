@@ -45,35 +45,14 @@
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/loops/correlative_matcher.h"
-#include "sdpslam/core/loops/frame_graph.h"
+#include "loops/frame_graph.h"
 #include "sdpslam/core/top/icp2d.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/sdp_stats.h"  // LoopClosureStats
 #include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
-
-struct LoopClosureStats {
-  std::uint64_t loop_records = 0U;          // loop constraints held now
-  std::uint64_t loop_refinements = 0U;      // obstacle-point ICP runs
-  std::uint64_t loop_records_added = 0U;    // ICP matches kept as loop constraints
-  std::uint64_t loop_records_dropped = 0U;  // kept matches that found no room (store full)
-  std::uint64_t loop_constraints_used = 0U; // in the last adjustment
-  std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
-  std::uint64_t loop_constraints_weak_direction = 0U;  // loop matches weak along a direction (corridors)
-  std::uint64_t loop_information_unmeasured = 0U;      // loop matches whose direction information failed
-  std::uint64_t frame_adjustments = 0U;     // pose-graph solves
-  std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
-  std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
-  std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_min_score
-  std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
-  std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)
-  std::uint64_t loop_search_refuted = 0U;   // ... found a peak that obstacle ICP did not confirm
-  std::uint64_t loop_search_closed = 0U;    // ... that became loop constraints
-  std::uint64_t loop_search_far = 0U;       // ... refused: would move their submap beyond loop_search_drift_m × √hops
-  std::uint64_t loop_search_recentred = 0U; // ... moving their submap over half the window: searched again around the peak
-  std::uint64_t loop_search_recentred_closed = 0U;  // of those, confirmed by that search (then recorded)
-};
 
 // The submaps loop closure works on: for each level the graph holds, the submap of the
 // best combination. Provided by the owner (SdpSlam).

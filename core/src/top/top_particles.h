@@ -28,7 +28,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/rng.h"
 #include "sdpslam/core/sdp_options.h"
-#include "sdpslam/core/top/segment_graph.h"
+#include "top/segment_graph.h"
 
 namespace sdpslam {
 

@@ -25,8 +25,8 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/state_io.h"
-#include "sdpslam/core/top/permanent_map.h"
-#include "sdpslam/core/top/skeleton_reader.h"
+#include "top/permanent_map.h"
+#include "top/skeleton_reader.h"
 
 namespace sdpslam {
 

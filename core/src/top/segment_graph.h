@@ -51,6 +51,7 @@
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/capacities.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/sdp_options.h"  // PgsAccumulation
 #include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
@@ -69,8 +70,6 @@ struct PgsNode {
   Pose2 initial_pose;
   Pose2 final_pose;
 };
-
-enum class PgsAccumulation : std::uint8_t { kSum, kMean };
 
 struct SegmentGraphOptions {
   std::uint32_t max_levels = 32U;       // in [2, capacity::kMaxPgsLevels]

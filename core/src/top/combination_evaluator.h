@@ -29,7 +29,7 @@
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/top/icp2d.h"
-#include "sdpslam/core/top/submap_store.h"
+#include "top/submap_store.h"
 
 namespace sdpslam {
 

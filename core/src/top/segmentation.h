@@ -13,16 +13,10 @@
 
 #include "sdpslam/core/pose2.h"
 #include "sdpslam/core/sdp_options.h"
+#include "sdpslam/core/sdp_stats.h"  // SegmentEnd
 #include "sdpslam/core/state_io.h"
 
 namespace sdpslam {
-
-// kWindow: SdpSlam ended the segment because the robot reached the edge of the square
-// its lineage may use in the DP map's torus (sdp_slam.h), whatever the mode says.
-// kPool: SdpSlam ended it because the DP map's observation pool could not take another
-// scan's writes (sdp_slam.h, make_room()).
-enum class SegmentEnd : std::uint8_t { kNone, kPeriod, kDispersion, kMaxLength, kWindow, kPool };
-const char* to_string(SegmentEnd reason);
 
 class Segmenter {
  public:
