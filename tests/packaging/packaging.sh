@@ -203,9 +203,16 @@ contents)
   fi
 
   # Development package: headers, static libraries, CMake package.
-  for h in core/arena.h core/pool.h core/pose2.h core/bottom/dpslam_filter.h hal/clock.h \
-           drivers/linux_clock.h drivers/scip2.h drivers/socketcan_bus.h io/log_reader.h io/trajectory_io.h; do
+  for h in core/arena.h core/pool.h core/pose2.h core/bottom/dpslam_filter.h core/sdp_slam.h core/sdp_stats.h \
+           hal/clock.h drivers/linux_clock.h drivers/scip2.h drivers/socketcan_bus.h io/log_reader.h io/trajectory_io.h; do
     has "$dev" "usr/include/sdpslam/$h"
+  done
+  # The core's own headers (core/src: the parts behind SdpSlam) are not API.
+  srcdir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$dir/CMakeCache.txt")
+  headers=$(dpkg-deb -c "$dev" | awk '{print $6}')
+  for h in $(cd "$srcdir/core/src" && find . -name '*.h' | sed 's|^\./||'); do
+    ! grep -qx "./usr/include/sdpslam/core/$h" <<<"$headers" \
+      || bad "$(basename "$dev") ships the core's private header core/src/$h"
   done
   for l in core drivers_common drivers_can drivers_serial io; do
     has "$dev" "usr/lib/$t/libsdpslam_$l.a"
@@ -218,7 +225,6 @@ contents)
   for c in sdpslamConfig.cmake sdpslamConfigVersion.cmake sdpslamTargets.cmake sdpslamTargets-release.cmake; do
     has "$dev" "usr/lib/$t/cmake/sdpslam/$c"
   done
-  srcdir=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$dir/CMakeCache.txt")
   grep -qF -e "$srcdir" -e "$dir" "$stage"/dev/usr/lib/"$t"/cmake/sdpslam/*.cmake \
     && bad "the CMake package names a path of the build machine"
   ! dpkg-deb -f "$dev" Depends | grep -q libeigen3-dev || bad "libsdpslam-dev depends on libeigen3-dev, which nothing uses"

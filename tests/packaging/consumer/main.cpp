@@ -1,5 +1,6 @@
 // Uses the installed library through its public headers only: an Arena and pools, Pose2
-// algebra, a DP-SLAM filter on a small arena, the Linux clock and a trajectory file.
+// algebra, a DP-SLAM filter and the SDP-SLAM engine on small arenas, the Linux clock and
+// a trajectory file.
 // Prints one line per check; exit status 0 iff every check holds.
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/pool.h"
 #include "sdpslam/core/pose2.h"
+#include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/core/version.h"
 #include "sdpslam/drivers/linux_clock.h"
 #include "sdpslam/io/trajectory_io.h"
@@ -78,6 +80,53 @@ int main(int argc, char** argv) {
   const bool init_ok = filter->init(o, filter_arena, 42U);
   if (!init_ok) std::printf("     why: %s\n", filter->why());
   check(init_ok && filter->initialised() && filter->particle_count() == 4U, "DpSlamFilter init on a small arena");
+
+  // SDP-SLAM: the engine's API compiles from the installed headers alone (its parts'
+  // headers are not installed), checks its options, refuses a too-small arena and runs.
+  sdpslam::SdpOptions sdp;
+  sdp.top_particles = 8U;
+  sdp.max_levels = 4U;
+  sdp.max_permanent_submaps = 8U;
+  char why[200] = {};
+  const bool sdp_ok = sdpslam::SdpSlam::check_options(o, sdp, why, sizeof why);
+  if (!sdp_ok) std::printf("     why: %s\n", why);
+  const std::size_t sdp_need = sdpslam::SdpSlam::required_arena_bytes(o, sdp);
+  std::vector<unsigned char> sdp_small(sdp_need / 2U);
+  std::vector<unsigned char> sdp_storage(sdp_need);
+  sdpslam::Arena sdp_small_arena(sdp_small.data(), sdp_small.size());
+  auto sdp_refused = std::make_unique<sdpslam::SdpSlam>();
+  check(sdp_ok && sdp_need > 0U && !sdp_refused->init(o, sdp, sdp_small_arena, 1U) && sdp_refused->why()[0] != '\0',
+        "SdpSlam checks its options and refuses a too-small arena");
+  sdpslam::Arena sdp_arena(sdp_storage.data(), sdp_storage.size());
+  auto slam = std::make_unique<sdpslam::SdpSlam>();
+  const bool slam_ok = slam->init(o, sdp, sdp_arena, 7U);
+  if (!slam_ok) std::printf("     why: %s\n", slam->why());
+  // Two scans 0.5 m apart in a 4 m square room: the first is processed, the estimate stays
+  // in the global frame's first segment.
+  auto scan = std::make_unique<sdpslam::RangeScan>();
+  scan->beam_count = 181U;
+  scan->geometry.angle_min_rad = static_cast<float>(-std::acos(0.0));
+  scan->geometry.angle_increment_rad = static_cast<float>(2.0 * std::acos(0.0) / 180.0);
+  scan->geometry.range_max_m = 10.0F;
+  std::uint64_t processed = 0U;
+  for (int k = 0; slam_ok && k < 2; ++k) {
+    const double x = 0.5 * k;
+    scan->stamp_us = 1000000 * (k + 1);
+    for (std::uint32_t i = 0; i < scan->beam_count; ++i) {
+      const double angle = scan->beam_angle_rad(i);
+      const double c = std::cos(angle);
+      const double s = std::sin(angle);
+      const double to_x = c > 1e-9 ? (2.0 - x) / c : 1e9;
+      const double to_y = std::fabs(s) > 1e-9 ? 2.0 / std::fabs(s) : 1e9;
+      scan->ranges_m[i] = static_cast<float>(to_x < to_y ? to_x : to_y);
+    }
+    sdpslam::OdometrySample odom;
+    odom.stamp_us = scan->stamp_us;
+    odom.pose = sdpslam::Pose2{x, 0.0, 0.0};
+    if (slam->process(odom, *scan).bottom.status == sdpslam::StepResult::Status::kProcessed) ++processed;
+  }
+  check(slam_ok && processed >= 1U && slam->stats().segments == 0U && slam->state_bytes() > 0U,
+        "SdpSlam init and process on a small arena");
 
   // Drivers: the monotonic clock moves forward.
   sdpslam::drivers::LinuxMonotonicClock clock;
