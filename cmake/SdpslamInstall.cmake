@@ -84,7 +84,7 @@ set(SDPSLAM_INSTALL_SYSTEMDDIR "lib/systemd/system")
 
 if(TARGET sdpslam)
   install(TARGETS sdpslam RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-  # Its ROS bag plugin (tools/io/CMakeLists.txt), found through its $ORIGIN run path.
+  # Its ROS bag plugin (tools/bags/CMakeLists.txt), found through its $ORIGIN run path.
   install(TARGETS sdpslam_bags LIBRARY DESTINATION ${SDPSLAM_BAG_PLUGIN_INSTALL_DIR} COMPONENT runtime)
 endif()
 set(_sdpslam_conffiles "")
@@ -118,8 +118,8 @@ if(TARGET sdpslamd)
   endforeach()
 endif()
 # The offline runner's documented defaults, as an example for `sdpslam run --config`.
-if(TARGET sdpslam AND EXISTS "${PROJECT_SOURCE_DIR}/tools/slam/default.ini")
-  install(FILES "${PROJECT_SOURCE_DIR}/tools/slam/default.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
+if(TARGET sdpslam AND EXISTS "${PROJECT_SOURCE_DIR}/firmware-host/runtime/slam/default.ini")
+  install(FILES "${PROJECT_SOURCE_DIR}/firmware-host/runtime/slam/default.ini" DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
     RENAME sdpslam-run.ini COMPONENT runtime)
 endif()
 

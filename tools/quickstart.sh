@@ -33,7 +33,7 @@ host_pkgs=(cmake ninja-build g++ pkg-config libcpputest-dev libpng-dev zlib1g-de
            libcli11-dev libinih-dev nlohmann-json3-dev libyaml-cpp-dev libcairo2-dev)
 test_pkgs=(clang libclang-rt-14-dev g++-aarch64-linux-gnu qemu-user qemu-system-x86 busybox-static cpio xz-utils
            dpkg-dev binutils lintian systemd)
-# ROS 1 and ROS 2 bags (tools/io, optional in a build): the test suite reads and writes them.
+# ROS 1 and ROS 2 bags (tools/bags, optional in a build): the test suite reads and writes them.
 rosbag_pkgs=(librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev libtf2-msgs-dev libsqlite3-dev libfastcdr-dev)
 arm64_pkgs=(libcpputest-dev:arm64)
 # Target libraries of the arm64 package build (tests/packaging). Optional: when the mirror's

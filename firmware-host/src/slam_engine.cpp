@@ -140,7 +140,7 @@ class DpSlamEngine final : public SlamEngine {
   std::uint64_t unrecorded_ = 0U;
 };
 
-// Segmented DP-SLAM: the offline runner's SDP loop (tools/slam run_sdp.cpp) one scan at
+// Segmented DP-SLAM: the offline runner's SDP loop (firmware-host/runtime/slam run_sdp.cpp) one scan at
 // a time, with its outputs built by the same functions (slam_outputs.h).
 class SdpEngine final : public SlamEngine {
  public:
@@ -322,7 +322,7 @@ class SdpEngine final : public SlamEngine {
 };
 
 // Localization on a saved map ([slam] mode = localize): the Monte Carlo localizer of
-// `sdpslam localize` (core/localization, tools/slam run_localize.h) one scan at a time.
+// `sdpslam localize` (core/localization, firmware-host/runtime/slam run_localize.h) one scan at a time.
 // The map is not changed: the outputs are the path on it and the map as loaded.
 class LocalizeEngine final : public SlamEngine {
  public:

@@ -266,7 +266,7 @@ std::string slurp_without_timing(const std::string& path) {
 
 }  // namespace
 
-// tools/slam/default.ini documents the defaults: given as --config it changes nothing, in
+// firmware-host/runtime/slam/default.ini documents the defaults: given as --config it changes nothing, in
 // either mode (sdp mode's profile keys and the mode's particle count are left out of it).
 TEST(CliRun, the_shipped_default_ini_changes_nothing) {
   Run r = run_cli("simulate --max-duration 15 --out " + dir + "/sim");

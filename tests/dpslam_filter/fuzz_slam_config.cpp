@@ -1,4 +1,4 @@
-// libFuzzer: the INI configuration of `sdpslam run` (tools/slam): load_config_ini (the
+// libFuzzer: the INI configuration of `sdpslam run` (firmware-host/runtime/slam): load_config_ini (the
 // filter's sections, on the built-in defaults and on the accurate profile as sdp mode
 // starts) and load_sdp_ini ([sdp]) over arbitrary file contents, read from memory.
 // Checks beyond the sanitizers: accepted options validate; a refusal names

@@ -1,4 +1,4 @@
-// ROS 1 bags as logs (tools/io/src/rosbag_source.h): bags written here with
+// ROS 1 bags as logs (tools/bags/src/rosbag_source.h): bags written here with
 // rosbag_storage, then read through LogReader. (The real ACES bag of ../shared is read
 // against its CARMEN log in test_shared_logs.cpp.)
 #include <CppUTest/TestHarness.h>

@@ -122,7 +122,7 @@ TEST(SdpConfig, every_row_refuses_values_outside_its_range_by_name) {
   check_rows_refuse_values_outside_their_range(DpSlamOptions::table());
 }
 
-// tools/slam/scan_match.ini (mode dpslam with the improved proposal) sets what the
+// firmware-host/runtime/slam/scan_match.ini (mode dpslam with the improved proposal) sets what the
 // accurate profile sets on the bottom level, and nothing else.
 TEST(SdpConfig, scan_match_ini_is_the_accurate_profile_s_bottom_level) {
   slam::SlamConfig c;

@@ -387,7 +387,7 @@ TEST(SdpslamdConfig, sdp_mode_and_sdp_options_are_accepted) {
 }
 
 TEST(SdpslamdConfig, offline_default_ini_loads_as_daemon_config_with_the_offline_sdp_values) {
-  // Every section of tools/slam/default.ini, [sdp] included, is a section of sdpslamd.
+  // Every section of firmware-host/runtime/slam/default.ini, [sdp] included, is a section of sdpslamd.
   DaemonConfig c;
   std::string error;
   CHECK_TRUE_TEXT(load_daemon_config(SDPSLAM_DEFAULT_INI, &c, &error), error.c_str());

@@ -1,6 +1,6 @@
 #!/bin/sh
 # DP-SLAM baseline benchmark: Intel and ACES at 30, 100 and 400 particles with ONE set
-# of options (tools/slam/default.ini unless CONFIG is given): relations error (mean±std,
+# of options (firmware-host/runtime/slam/default.ini unless CONFIG is given): relations error (mean±std,
 # `sdpslam evaluate`), CPU seconds of the whole run (user+sys from /usr/bin/time: the
 # machine may be shared, so wall time is not the figure), per-scan CPU time p50/p99/max and
 # pool high-water marks from each run's stats.json, peak RSS, and the memory a naive
@@ -20,7 +20,7 @@ build=${1:?usage: bench_dpslam.sh BUILD_DIR [OUT_DIR] [PARTICLES...]}
 out=${2:-/tmp/sdpslam-dpslam-bench}
 shift 2 2>/dev/null || shift $#
 particles=${*:-"30 100 400"}
-config=${CONFIG:-$root/tools/slam/default.ini}
+config=${CONFIG:-$root/firmware-host/runtime/slam/default.ini}
 seed=${SEED:-1}
 shared=${SHARED:-$root/../shared}
 logs=${LOGS:-"intel aces"}

@@ -1,6 +1,6 @@
 #!/bin/sh
 # SDP-SLAM benchmark: Intel and ACES with ONE option set (the default profile, accurate,
-# with tools/slam/default.ini on top unless PROFILE / CONFIG say otherwise) at the
+# with firmware-host/runtime/slam/default.ini on top unless PROFILE / CONFIG say otherwise) at the
 # paper's 60T/10B unless TB says otherwise: relations error
 # through `sdpslam evaluate`, per-scan time (median, p99, max), the fixed arena declared
 # at init, pool high-water marks and peak RSS from each run's stats.json.
@@ -16,7 +16,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 build=${1:?usage: bench_sdp.sh BUILD_DIR [OUT_DIR]}
 out=${2:-/tmp/sdpslam-sdp-bench}
-config=${CONFIG:-$root/tools/slam/default.ini}
+config=${CONFIG:-$root/firmware-host/runtime/slam/default.ini}
 profile=${PROFILE:-accurate}
 seed=${SEED:-1}
 shared=${SHARED:-$root/../shared}

@@ -14,7 +14,7 @@
 #   e.g. tools/bench/compare_paper.sh build/release /tmp/sdpslam-paper
 #
 # Environment: SEED (default 1), SHARED (default ../shared beside the checkout),
-# DATASETS (default "sim intel"), CONFIG (INI for every run, default tools/slam/default.ini),
+# DATASETS (default "sim intel"), CONFIG (INI for every run, default firmware-host/runtime/slam/default.ini),
 # PROFILE (sdp runs' --profile, default paper: the paper's algorithm, as in its Table I;
 # accurate adds scan-matching proposals and loop closure to both topologies).
 # Use a Release build; the Intel part takes a while.
@@ -26,7 +26,7 @@ out=${2:-/tmp/sdpslam-paper}
 seed=${SEED:-1}
 shared=${SHARED:-$root/../shared}
 datasets=${DATASETS:-"sim intel"}
-config=${CONFIG:-$root/tools/slam/default.ini}
+config=${CONFIG:-$root/firmware-host/runtime/slam/default.ini}
 profile=${PROFILE:-paper}
 bin="$build/tools/cli/sdpslam"
 [ -x "$bin" ] || { echo "compare_paper.sh: no sdpslam binary in $build" >&2; exit 2; }

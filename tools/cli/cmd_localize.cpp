@@ -1,5 +1,5 @@
 // `sdpslam localize LOG --map map.yaml --out D`: Monte Carlo localization of a log on a
-// saved map (tools/slam run_localize.h), globally or from --start.
+// saved map (firmware-host/runtime/slam run_localize.h), globally or from --start.
 #include <cstdio>
 #include <memory>
 #include <string>

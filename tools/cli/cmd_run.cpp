@@ -3,9 +3,9 @@
 //               [--seed S] [--memory-budget-mib M] [--snapshot FILE [--snapshot-every-s S]]
 //               [--resume FILE | --extend FILE [--extend-window-m M]] --out DIR`
 // sdp (the default): Segmented DP-SLAM, 60 top-level / 10 bottom-level particles
-// (tools/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
+// (firmware-host/runtime/slam/run_sdp.h), starting from the options of --profile (core/sdp_profile.h:
 // accurate by default, or the paper's algorithm) with the --config file's keys on top;
-// dpslam: the bottom-level DP-SLAM filter alone, the baseline (tools/slam/run_offline.h).
+// dpslam: the bottom-level DP-SLAM filter alone, the baseline (firmware-host/runtime/slam/run_offline.h).
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -275,7 +275,7 @@ std::function<int()> setup_run(CLI::App& app) {
                  "closure and wide loop search) or paper (the paper's algorithm); core/sdp_profile.h")
       ->check(CLI::IsMember({"accurate", "paper"}));
   app.add_option("--config", args->config,
-                 "INI options on top of the profile: bottom level and [sdp] (see tools/slam/default.ini)");
+                 "INI options on top of the profile: bottom level and [sdp] (see firmware-host/runtime/slam/default.ini)");
   app.add_option("--seed", args->seed, "Random seed (same seed, same output)")->check(whole_number(UINT64_MAX));
   app.add_option("--out", args->out, "Output directory")->required()->check(non_empty());
   app.add_option("--memory-budget-mib", args->memory_budget_mib,
@@ -317,7 +317,7 @@ std::function<int()> setup_run(CLI::App& app) {
     }
     // Options of the top level mean nothing to DP-SLAM alone: refused, not ignored.
     if (!sdp && !args->profile.empty()) {
-      return report("", kExitUsage, "--profile applies to --mode sdp (dpslam starts from tools/slam/default.ini)");
+      return report("", kExitUsage, "--profile applies to --mode sdp (dpslam starts from firmware-host/runtime/slam/default.ini)");
     }
     if (!sdp && (args->top_particles != 0U || !args->topology.empty())) {
       return report("", kExitUsage, "--top-particles and --topology apply to --mode sdp");

@@ -1,7 +1,7 @@
 #pragma once
 // Options of the bottom-level DP-SLAM filter (paper §II-A, Algorithm 1 line 3), validated
 // once (Cartographer style): validate() range-checks every field and names the first
-// bad one with its allowed range. Every field has a key in tools/slam/default.ini.
+// bad one with its allowed range. Every field has a key in firmware-host/runtime/slam/default.ini.
 #include <cstddef>
 #include <cstdint>
 

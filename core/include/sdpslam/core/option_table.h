@@ -1,7 +1,7 @@
 #pragma once
 // One table per options struct: each field's INI section and key, how it is reached,
 // its kind, unit, range and a one-line doc. The struct's validate() checks every range
-// from its table, then the checks that join fields; the INI readers (tools/slam
+// from its table, then the checks that join fields; the INI readers (firmware-host/runtime/slam
 // option_text.h), the shipped .ini files' test and `--print-config` read the same
 // table, so a field is declared once. Tables are constant data: no heap, no OS.
 #include <cstddef>

@@ -2,7 +2,7 @@
 // Options of SDP-SLAM's segmentation and top level (paper §III, Algorithm 1 lines 4-12),
 // validated once: validate() range-checks every field and names the first bad one.
 // The bottom level keeps its own DpSlamOptions (dpslam_options.h); every field here has
-// a key in the [sdp] section of tools/slam/default.ini.
+// a key in the [sdp] section of firmware-host/runtime/slam/default.ini.
 #include <cstddef>
 #include <cstdint>
 

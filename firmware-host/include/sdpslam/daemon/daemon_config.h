@@ -9,7 +9,7 @@
 //   [slam]    mode (sdp | dpslam | localize), profile (sdp mode's starting options, applied before
 //             every other key wherever it stands) and seed; the filter's own sections [filter] [motion]
 //             [observation] [proposal] [map] [capacity] [log] are the offline runner's
-//             (tools/slam/default.ini), parsed by the same code (slam::apply_config_key)
+//             (firmware-host/runtime/slam/default.ini), parsed by the same code (slam::apply_config_key)
 //   [sdp]     SDP-SLAM's segmentation and top level (mode = sdp), the offline runner's
 //             [sdp] keys, parsed by the same code (slam::apply_sdp_key); read in either
 //             mode, used in sdp mode only. The bottom level of sdp mode is [filter] etc.,

@@ -5,7 +5,7 @@
 // (Monte Carlo localization on a saved map, core/localization, with [localize]).
 //
 // Both write what the offline runner writes from the same state, through the same code
-// (tools/slam slam_outputs.h): dpslam the best particle's path and map, sdp the best
+// (firmware-host/runtime/slam slam_outputs.h): dpslam the best particle's path and map, sdp the best
 // combination's path (permanent segments + live chain) and global map.
 //
 // An engine owns all of its memory, sized once at create time from the options; process()

@@ -2,7 +2,7 @@
 // Figures of the outputs (a map with the path driven on it, a chart of a figure over
 // time) as data, and the painter that draws them into PNG files.
 //
-// The runners (tools/slam) describe what to draw; who draws it is chosen by the program:
+// The runners (firmware-host/runtime/slam) describe what to draw; who draws it is chosen by the program:
 // plain_painter() rasterises without text (libpng only: the robot program and the cross
 // builds use it), the `sdpslam` CLI uses plot::painter() (tools/plot: cairo), which adds
 // title, axes with tick labels and units, a legend and, on maps, a scale bar.

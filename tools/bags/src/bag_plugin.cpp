@@ -6,7 +6,7 @@
 #include "rosbag_source.h"
 
 #ifndef SDPSLAM_BAG_PLUGIN_BUILD
-#error "SDPSLAM_BAG_PLUGIN_BUILD names the build (tools/io/CMakeLists.txt)"
+#error "SDPSLAM_BAG_PLUGIN_BUILD names the build (tools/bags/CMakeLists.txt)"
 #endif
 
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// INI configuration of the bottom-level filter (tools/slam/default.ini documents every
+// INI configuration of the bottom-level filter (firmware-host/runtime/slam/default.ini documents every
 // key). Sections and keys mirror DpSlamOptions; `[log] default_range_max_m` sets the
 // log reader's no-return threshold for formats that do not carry one.
 #include <cstdio>

@@ -8,7 +8,7 @@
 //    composed with the odometry since.
 //  - best_map_image: the best particle's occupancy grid over every tile ever written.
 //  - write_trajectory_and_map: trajectory.txt, map.pgm/.yaml and map.png (with the
-//    trajectory drawn) in out_dir, each atomically (tools/io).
+//    trajectory drawn) in out_dir, each atomically (firmware-host/runtime/io).
 // and of an SDP-SLAM run (core/sdp_slam.h; `sdpslam run --mode sdp`, sdpslamd
 // [slam] mode = sdp), so both write the best combination's path and global map:
 //  - sdp_best_path: the best combination's poses, the input of assemble_trajectory;

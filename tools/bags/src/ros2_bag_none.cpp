@@ -1,4 +1,4 @@
-// A build without ROS 2 bag support (tools/io/CMakeLists.txt: libsqlite3 or Fast-CDR was
+// A build without ROS 2 bag support (tools/bags/CMakeLists.txt: libsqlite3 or Fast-CDR was
 // not found): bags are recognised and refused with what to install.
 #include "ros2_bag_source.h"
 

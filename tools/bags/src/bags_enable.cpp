@@ -13,10 +13,10 @@
 #include "sdpslam/io/bags.h"
 
 #ifndef SDPSLAM_BAG_PLUGIN_BUILD
-#error "SDPSLAM_BAG_PLUGIN_BUILD names the build (tools/io/CMakeLists.txt)"
+#error "SDPSLAM_BAG_PLUGIN_BUILD names the build (tools/bags/CMakeLists.txt)"
 #endif
 #ifndef SDPSLAM_BAG_PLUGIN_INSTALLED_DIR
-#error "SDPSLAM_BAG_PLUGIN_INSTALLED_DIR is where an installed plugin lies (tools/io/CMakeLists.txt)"
+#error "SDPSLAM_BAG_PLUGIN_INSTALLED_DIR is where an installed plugin lies (tools/bags/CMakeLists.txt)"
 #endif
 
 namespace sdpslam::io {

@@ -1,4 +1,4 @@
-// A build without ROS 1 bag support (tools/io/CMakeLists.txt: the ROS packages were not
+// A build without ROS 1 bag support (tools/bags/CMakeLists.txt: the ROS packages were not
 // found): bags are recognised and refused with what to install.
 #include "rosbag_source.h"
 

@@ -9,7 +9,7 @@
 // in LIBDIR/sdpslam and loaded the first time a bag is opened: a run on any other log
 // maps none of those libraries. A missing plugin, or one from another build, is refused
 // with what went wrong. Each kind of bag needs its Debian packages at build time
-// (tools/io/CMakeLists.txt); a build without them refuses that kind with what to install.
+// (tools/bags/CMakeLists.txt); a build without them refuses that kind with what to install.
 //
 // ROS 2 bags (rosbag2, SQLite 3 storage): a folder holding metadata.yaml and
 // NAME_0.db3, messages serialised as CDR (little-endian XCDR1, as rmw_fastrtps writes
