@@ -7,6 +7,7 @@
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/run_localize.h"
+#include "sdpslam/slam/sdp_session.h"
 #include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/slam_outputs.h"
 
@@ -140,67 +141,32 @@ class DpSlamEngine final : public SlamEngine {
   std::uint64_t unrecorded_ = 0U;
 };
 
-// Segmented DP-SLAM: the offline runner's SDP loop (firmware-host/runtime/slam run_sdp.cpp) one scan at
-// a time, with its outputs built by the same functions (slam_outputs.h).
+// Segmented DP-SLAM: the session the offline runner runs (runtime/slam sdp_session.h),
+// fed one scan at a time, with its outputs built by the same functions.
 class SdpEngine final : public SlamEngine {
  public:
   bool init(const DaemonConfig& c, std::string* error) {
-    const DpSlamOptions& fo = c.slam.filter;
-    char why[200];
-    if (!fo.validate(why, sizeof why) || !c.sdp.validate(why, sizeof why)) {
-      *error = std::string("invalid SLAM options: ") + why;
-      return false;
-    }
-    arena_bytes_ = SdpSlam::required_arena_bytes(fo, c.sdp);
-    if (arena_bytes_ == 0U) {
-      *error = "invalid SDP-SLAM options (arena size)";
-      return false;
-    }
-    buffer_.reset(new unsigned char[arena_bytes_]);
-    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
-    slam_ = std::make_unique<SdpSlam>();
-    if (!slam_->init(fo, c.sdp, *arena_, c.seed)) {
-      *error = std::string("SDP-SLAM init failed: ") + slam_->why();
-      return false;
-    }
-    // A level holds at least min_segment_scans processed scans.
-    permanent_.reserve(c.max_trajectory_scans, c.max_trajectory_scans / c.sdp.min_segment_scans + 1U);
-    slam_->set_permanent_sink(&permanent_);
-    scans_.reserve(c.max_trajectory_scans);
+    if (!session_.create(c.slam.filter, c.sdp, c.seed, false, error)) return false;
+    session_.reserve_records(c.max_trajectory_scans);
     output_directory_ = c.output_directory;
     return true;
   }
 
   const char* name() const override { return "sdp"; }
 
-  EngineStep process(const OdometrySample& odom_in, const RangeScan& scan_in) override {
-    // After a resume the input does not follow the session without a break: its
-    // odometry starts from its own origin, its clock may have started again, and the
-    // robot may have been moved (slam/session_continuation.h carries all three across;
-    // the scan is copied into a buffer reserved at create time, as the stamp may move).
-    OdometrySample odom = odom_in;
-    const RangeScan* scan = &scan_in;
-    if (continuation_.active()) {
-      *carried_ = scan_in;
-      scan = carried_.get();
-      const slam::ContinuationReport::Place before = continuation_.report().place;
-      const bool feed = continuation_.carry(&odom, carried_.get(), *slam_);
-      if (continuation_.report().place != before) notice_ = continuation_.report().describe();
-      if (!feed) {
-        EngineStep held;
-        held.placed = false;
-        held.pose = last_pose_;
-        return held;
-      }
-    }
-    last_odom_ = odom.pose;
-    const SdpStepResult r = slam_->process(odom, *scan);
+  EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
+    const slam::ContinuationReport::Place before = session_.continuation().report().place;
+    SdpStepResult r;
+    const bool fed = session_.feed(odom, scan, &r);
+    if (session_.continuation().report().place != before) notice_ = session_.continuation().report().describe();
     EngineStep s;
+    if (!fed) {  // held back: a resumed session is looking for the robot
+      s.placed = false;
+      s.pose = session_.last_pose();
+      return s;
+    }
     s.processed = r.bottom.status == StepResult::Status::kProcessed;
     s.pose = r.pose;  // global frame, best top-level particle
-    last_pose_ = r.pose;
-    if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
-    else ++unrecorded_;
     return s;
   }
 
@@ -213,36 +179,35 @@ class SdpEngine final : public SlamEngine {
   // The bottom-level particles live in the segment's frame: turned into the map frame by
   // the best particle's heading there and the estimate's heading here.
   PoseSpread spread() const override {
-    const DpSlamFilter& bottom = slam_->bottom();
+    const DpSlamFilter& bottom = session_.slam().bottom();
     return spread_of(bottom.particle_count(), [&bottom](std::uint32_t i) { return bottom.particle_pose(i); },
-                     last_pose_.heading_rad - bottom.best_pose().heading_rad);
+                     session_.last_pose().heading_rad - bottom.best_pose().heading_rad);
   }
 
-  std::vector<io::StampedPose> trajectory() const override {
-    return slam::assemble_trajectory(scans_, slam::sdp_best_path(*slam_, permanent_), &path_gaps_);
-  }
+  std::vector<io::StampedPose> trajectory() const override { return session_.trajectory(&path_gaps_); }
 
   std::uint32_t map_image(io::OccupancyImage* image) const override {
-    known_cells_ = slam::sdp_global_map_image(*slam_, image);
+    known_cells_ = session_.map_image(image);
     return known_cells_;
   }
 
-  void finish() override { slam_->finish(); }
+  void finish() override { session_.finish(); }
 
   io::Json status_json() const override {
-    io::Json js = {{"particles", slam_->bottom().particle_count()},
-                   {"top_particles", slam_->options().top_particles},
-                   {"processed", slam_->bottom().stats().processed},
-                   {"committed_poses_dropped", permanent_.dropped()},
-                   {"unrecorded_scans", unrecorded_}};
+    const SdpSlam& slam = session_.slam();
+    io::Json js = {{"particles", slam.bottom().particle_count()},
+                   {"top_particles", slam.options().top_particles},
+                   {"processed", slam.bottom().stats().processed},
+                   {"committed_poses_dropped", session_.permanent().dropped()},
+                   {"unrecorded_scans", session_.unrecorded()}};
     // The offline runner's stats.json members; trajectory gaps and known cells as of the
     // last trajectory() / map_image().
-    js.update(slam::sdp_state_json(*slam_, arena_bytes_, arena_->used_bytes(), path_gaps_, known_cells_));
-    if (continuation_.active()) js["resumed"] = continuation_.report().json();
+    js.update(session_.state_json(path_gaps_, known_cells_));
+    if (session_.continuation().active()) js["resumed"] = session_.continuation().report().json();
     return js;
   }
 
-  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+  std::uint64_t unrecorded_scans() const override { return session_.unrecorded(); }
 
   bool has_snapshots() const override { return true; }
 
@@ -251,12 +216,12 @@ class SdpEngine final : public SlamEngine {
     io::SnapshotOut out;
     if (!out.open(path, fingerprint, error)) return false;
     out.put_bytes(kSnapshotPart, sizeof kSnapshotPart);
-    io::put_vector(out, scans_);
-    out.put_u64(unrecorded_);
-    out.write(&last_odom_, sizeof last_odom_);
-    permanent_.write_state(out);
-    if (!slam_->save_state(out)) {
-      *error = path + ": " + slam_->why();
+    io::put_vector(out, session_.records());
+    out.put_u64(session_.unrecorded());
+    out.write(&session_.last_odom(), sizeof(Pose2));
+    session_.permanent().write_state(out);
+    if (!session_.slam().save_state(out)) {
+      *error = path + ": " + session_.slam().why();
       return false;
     }
     if (!out.commit(error)) return false;
@@ -276,46 +241,42 @@ class SdpEngine final : public SlamEngine {
       return false;
     }
     // The records keep the room reserved at create time: a longer one is refused.
-    if (!io::get_vector(in, &scans_, scans_.capacity()) || !in.get_u64(&unrecorded_) ||
-        !in.read(&last_odom_, sizeof last_odom_) || !permanent_.read_state(in)) {
+    std::vector<slam::ScanRecord>& records = session_.records();
+    std::uint64_t unrecorded = 0U;
+    Pose2 last_odom;
+    if (!io::get_vector(in, &records, records.capacity()) || !in.get_u64(&unrecorded) ||
+        !in.read(&last_odom, sizeof last_odom) || !session_.permanent().read_state(in)) {
       *error = path + ": the snapshot's records are damaged or longer than [output] max_trajectory_scans";
       return false;
     }
-    if (!slam_->load_state(in)) {
-      *error = path + ": " + slam_->why();
+    session_.set_unrecorded(unrecorded);
+    session_.set_last_odom(last_odom);
+    if (!session_.slam().load_state(in)) {
+      *error = path + ": " + session_.slam().why();
       return false;
     }
     if (!in.at_end()) {
       *error = path + ": the snapshot holds more than this program reads";
       return false;
     }
-    *scans = scans_.size() + unrecorded_;
+    *scans = records.size() + unrecorded;
     // The trajectory written every [output] period_s holds where the robot went after
     // the snapshot (minutes apart): its last pose, if later, is where to look first.
-    const std::int64_t last_stamp_us = scans_.empty() ? 0 : scans_.back().stamp_us;
+    const std::int64_t last_stamp_us = records.empty() ? 0 : records.back().stamp_us;
     std::vector<io::StampedPose> written;
     std::string ignored;
     const bool later = !output_directory_.empty() &&
                        io::read_trajectory(output_directory_ + "/trajectory.txt", &written, &ignored) &&
                        !written.empty() && written.back().stamp_us > last_stamp_us;
-    continuation_.begin(last_odom_, last_stamp_us, later ? &written.back().pose : nullptr);
+    session_.continuation().begin(last_odom, last_stamp_us, later ? &written.back().pose : nullptr);
     return true;
   }
 
  private:
   static constexpr char kSnapshotPart[] = "sdpslamd sdp 1";
-  std::size_t arena_bytes_ = 0U;
-  std::unique_ptr<unsigned char[]> buffer_;
-  std::unique_ptr<Arena> arena_;
-  std::unique_ptr<SdpSlam> slam_;
-  slam::SdpPermanentPath permanent_;  // the segments made permanent
-  std::vector<slam::ScanRecord> scans_;
-  std::uint64_t unrecorded_ = 0U;
-  Pose2 last_odom_{};     // the last scan's odometry, in the session's odometry frame
-  Pose2 last_pose_{};     // the last scan's estimate (spread())
-  slam::SessionContinuation continuation_{slam::SessionContinuation::kDefaultWindowM, true};  // after a resume
+  // A resumed session most likely goes on where the robot stopped (sdpslamd restarted).
+  slam::SdpSession session_{slam::SessionContinuation::kDefaultWindowM, true};
   std::string output_directory_;
-  std::unique_ptr<RangeScan> carried_ = std::make_unique<RangeScan>();
   std::string notice_;
   mutable std::uint64_t path_gaps_ = 0U;
   mutable std::uint32_t known_cells_ = 0U;

@@ -21,6 +21,7 @@
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
 #include "sdpslam/slam/ini_document.h"
+#include "sdpslam/slam/sdp_session.h"
 #include "sdpslam/slam/session_continuation.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
@@ -30,27 +31,12 @@ namespace {
 
 // ---- outputs ------------------------------------------------------------------------
 
-struct Row {
-  std::int64_t stamp_us;
-  double mean_m;
-  double std_m;
-  std::uint32_t samples;
-};
-
-class Rows final : public TopLevelListener {
- public:
-  void on_round(std::int64_t stamp_us, double mean_m, double std_m, std::uint32_t samples) override {
-    rows.push_back(Row{stamp_us, mean_m, std_m, samples});
-  }
-  std::vector<Row> rows;
-};
-
 using detail::percentile;
 using detail::rusage_cpu_s;
 using detail::thread_cpu_ms;
 
 // The per-round ICP error over time: its mean, with a band of ± one standard deviation.
-io::Chart error_chart(const std::vector<Row>& rows, std::int64_t t0_us) {
+io::Chart error_chart(const std::vector<IcpRound>& rows, std::int64_t t0_us) {
   io::Chart chart;
   chart.title = "Top-level ICP error of the chosen segments";
   chart.x_label = "time since the first scan (s)";
@@ -58,7 +44,7 @@ io::Chart error_chart(const std::vector<Row>& rows, std::int64_t t0_us) {
   io::ChartSeries band =
       io::ChartSeries::named("mean ± 1 standard deviation", io::Rgb8{70, 110, 200}, io::ChartSeries::Style::kBand);
   io::ChartSeries mean = io::ChartSeries::named("mean", io::Rgb8{20, 50, 150});
-  for (const Row& r : rows) {
+  for (const IcpRound& r : rows) {
     const double t_s = static_cast<double>(r.stamp_us - t0_us) * 1e-6;
     band.x.push_back(t_s);
     band.y.push_back(std::max(0.0, r.mean_m - r.std_m));
@@ -112,21 +98,16 @@ namespace {
 // scans so far.
 constexpr char kRunnerPart[] = "sdpslam run sdp 1";
 
-struct RunnerState {
-  std::vector<ScanRecord> scans;
-  std::vector<Row> rows;
-};
-
-bool write_snapshot(const SdpRunOptions& options, const std::vector<ScanRecord>& scans, const std::vector<Row>& rows,
-                    const SdpPermanentPath& permanent, SdpSlam& slam, std::uint64_t* file_bytes, std::string* error) {
+bool write_snapshot(const SdpRunOptions& options, SdpSession& session, std::uint64_t* file_bytes,
+                    std::string* error) {
   io::SnapshotOut out;
   if (!out.open(options.snapshot_path, options.config_fingerprint, error)) return false;
   out.put_bytes(kRunnerPart, sizeof kRunnerPart);
-  io::put_vector(out, scans);
-  io::put_vector(out, rows);
-  permanent.write_state(out);
-  if (!slam.save_state(out)) {
-    *error = options.snapshot_path + ": " + slam.why();
+  io::put_vector(out, session.records());
+  io::put_vector(out, session.rounds());
+  session.permanent().write_state(out);
+  if (!session.slam().save_state(out)) {
+    *error = options.snapshot_path + ": " + session.slam().why();
     return false;
   }
   if (!out.commit(error)) return false;
@@ -134,8 +115,7 @@ bool write_snapshot(const SdpRunOptions& options, const std::vector<ScanRecord>&
   return true;
 }
 
-bool read_snapshot(const SdpRunOptions& options, const std::string& path, RunnerState* st,
-                   SdpPermanentPath* permanent, SdpSlam& slam, std::string* error) {
+bool read_snapshot(const SdpRunOptions& options, const std::string& path, SdpSession& session, std::string* error) {
   io::SnapshotInfo info;
   if (!io::check_snapshot(path, options.config_fingerprint, &info, error)) return false;
   io::SnapshotIn in;
@@ -145,12 +125,13 @@ bool read_snapshot(const SdpRunOptions& options, const std::string& path, Runner
     *error = path + ": not a snapshot of `sdpslam run` in sdp mode";
     return false;
   }
-  if (!io::get_vector(in, &st->scans) || !io::get_vector(in, &st->rows) || !permanent->read_state(in)) {
+  if (!io::get_vector(in, &session.records()) || !io::get_vector(in, &session.rounds()) ||
+      !session.permanent().read_state(in)) {
     *error = path + ": snapshot's runner part is damaged";
     return false;
   }
-  if (!slam.load_state(in)) {
-    *error = path + ": " + slam.why();
+  if (!session.slam().load_state(in)) {
+    *error = path + ": " + session.slam().why();
     return false;
   }
   if (!in.at_end()) {
@@ -178,38 +159,21 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   if (!outputs.begin(out_dir, error)) return SdpRunStatus::kIoError;
 
   // The whole state: one arena sized at init (the fixed memory budget).
-  const std::size_t arena_bytes = sdp_state_bytes(options);
-  if (arena_bytes == 0U) {
-    *error = "invalid options (arena size)";
-    return SdpRunStatus::kBadInput;
-  }
-  std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
-  Arena arena(buffer.get(), arena_bytes);
-  auto slam = std::make_unique<SdpSlam>();
-  if (!slam->init(fo, options.sdp, arena, options.seed)) {
-    *error = std::string("SDP-SLAM init failed: ") + slam->why();
-    return SdpRunStatus::kInternal;
-  }
-  SdpPermanentPath permanent;
-  Rows rows;
-  slam->set_permanent_sink(&permanent);
-  slam->set_listener(&rows);
+  SdpSession session(options.extend_window_m);
+  if (!session.create(fo, options.sdp, options.seed, true, error)) return SdpRunStatus::kInternal;
+  SdpSlam& slam = session.slam();
+  const std::vector<ScanRecord>& scans = session.records();
 
-  RunnerState resumed;
   if (!options.resume_path.empty() && !options.extend_path.empty()) {
     *error = "a run resumes its own log or extends a session with another, not both";
     return SdpRunStatus::kBadInput;
   }
   const std::string& saved_path = options.resume_path.empty() ? options.extend_path : options.resume_path;
-  if (!saved_path.empty()) {
-    if (!read_snapshot(options, saved_path, &resumed, &permanent, *slam, error)) return SdpRunStatus::kBadInput;
-    rows.rows = resumed.rows;
-  }
-  SessionContinuation continuation(options.extend_window_m);
-  const std::size_t extended_after = options.extend_path.empty() ? 0U : resumed.scans.size();
-  if (extended_after > 0U) continuation.begin(resumed.scans.back().odom, resumed.scans.back().stamp_us);
-  const std::size_t resume_at = options.extend_path.empty() ? resumed.scans.size() : 0U;
-  std::vector<ScanRecord> scans = std::move(resumed.scans);
+  if (!saved_path.empty() && !read_snapshot(options, saved_path, session, error)) return SdpRunStatus::kBadInput;
+  const std::size_t extended_after = options.extend_path.empty() ? 0U : scans.size();
+  if (extended_after > 0U) session.continuation().begin(scans.back().odom, scans.back().stamp_us);
+  const std::size_t resume_at = options.extend_path.empty() ? scans.size() : 0U;
+  const SessionContinuation& continuation = session.continuation();
   std::uint64_t snapshots = 0U;
   std::uint64_t snapshot_bytes = 0U;
   double snapshot_ms_max = 0.0;
@@ -218,7 +182,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   std::int64_t last_snapshot_us = scans.empty() ? 0 : scans.back().stamp_us;
   auto snapshot = [&]() {
     const auto s0 = std::chrono::steady_clock::now();
-    if (!write_snapshot(options, scans, rows.rows, permanent, *slam, &snapshot_bytes, error)) return false;
+    if (!write_snapshot(options, session, &snapshot_bytes, error)) return false;
     ++snapshots;
     snapshot_ms_max = std::max(
         snapshot_ms_max, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count());
@@ -237,8 +201,6 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   detail::ScanOdometryPairing pairing;
   OdometrySample od;
   std::size_t index = 0U;  // of the scan (with odometry) in the log
-  auto scan_buffer = std::make_unique<RangeScan>();  // the scan as fed (stamp shifted by an extension)
-  RangeScan& scan = *scan_buffer;
   while (pairing.next(reader, &od)) {
     const io::LaserRecord& rec = reader.laser();
     if (index < resume_at) {
@@ -256,14 +218,12 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     ++index;
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
-    scan = rec.scan;
-    OdometrySample odom = od;
-    if (!continuation.carry(&odom, &scan, *slam)) {
+    SdpStepResult r;
+    if (!session.feed(od, rec.scan, &r)) {
       // Held back while an extension looks for the robot in the saved map.
       if (options.progress) options.progress(reader.input_offset());
       continue;
     }
-    const SdpStepResult r = slam->process(odom, scan);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     scan_ms.push_back(ms);
     const double cpu = thread_cpu_ms() - c0;
@@ -276,15 +236,15 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     split = std::max(split, cpu);
     if (cpu > 100.0) ++scans_cpu_over_100ms;
     if (r.segmented != SegmentEnd::kNone) segment_ms.push_back(ms);
-    scans.push_back(ScanRecord{scan.stamp_us, odom.pose, r.pose, r.bottom.status == StepResult::Status::kProcessed});
     if (options.progress) options.progress(reader.input_offset());
+    const std::int64_t fed_stamp_us = scans.back().stamp_us;  // shifted by an extension
     if (!options.snapshot_path.empty() && options.snapshot_every_s > 0.0) {
       if (!snapshot_clock_set) {
         snapshot_clock_set = true;
-        last_snapshot_us = scan.stamp_us;
-      } else if (static_cast<double>(scan.stamp_us - last_snapshot_us) * 1e-6 >= options.snapshot_every_s) {
+        last_snapshot_us = fed_stamp_us;
+      } else if (static_cast<double>(fed_stamp_us - last_snapshot_us) * 1e-6 >= options.snapshot_every_s) {
         if (!snapshot()) return SdpRunStatus::kIoError;
-        last_snapshot_us = scan.stamp_us;
+        last_snapshot_us = fed_stamp_us;
       }
     }
   }
@@ -299,35 +259,34 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   }
   // The last one: the state before finish(), which only completes pending work.
   if (!options.snapshot_path.empty() && !snapshot()) return SdpRunStatus::kIoError;
-  slam->finish();
+  session.finish();
 
   // The best combination's path: permanent segments, then the live chain.
   std::uint64_t path_gaps = 0U;
-  const std::vector<io::StampedPose> trajectory =
-      assemble_trajectory(scans, sdp_best_path(*slam, permanent), &path_gaps);
+  const std::vector<io::StampedPose> trajectory = session.trajectory(&path_gaps);
 
   io::OccupancyImage image;
-  const std::uint32_t known_cells = sdp_global_map_image(*slam, &image);
+  const std::uint32_t known_cells = session.map_image(&image);
   if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error, &options.painter)) {
     return SdpRunStatus::kIoError;
   }
   std::string csv = "stamp_s,mean_m,std_m,samples\n";
-  for (const Row& r : rows.rows) {
+  for (const IcpRound& r : session.rounds()) {
     char line[128];
     std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%u\n", io::format_stamp_us(r.stamp_us).c_str(), r.mean_m, r.std_m,
                   r.samples);
     csv += line;
   }
   if (!io::write_file_atomic(outputs.path("icp_error.csv"), csv, error)) return SdpRunStatus::kIoError;
-  if (!io::write_file_atomic(outputs.path("loops.tsv"), sdp_loops_tsv(*slam), error)) return SdpRunStatus::kIoError;
-  const io::Chart chart = error_chart(rows.rows, scans.front().stamp_us);
+  if (!io::write_file_atomic(outputs.path("loops.tsv"), sdp_loops_tsv(slam), error)) return SdpRunStatus::kIoError;
+  const io::Chart chart = error_chart(session.rounds(), scans.front().stamp_us);
   if (io::chart_has_data(chart) && !options.painter.chart(outputs.path("icp_error.png"), chart, error)) {
     return SdpRunStatus::kIoError;
   }
 
   // stats.json
-  const DpSlamStats& bs = slam->bottom().stats();
-  const SdpStats& st = slam->stats();
+  const DpSlamStats& bs = slam.bottom().stats();
+  const SdpStats& st = slam.stats();
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -348,7 +307,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   js["odometry_reversals_repaired"] = reader.odometry_reversals_repaired();
   js["odometry_jumps_removed"] = reader.odometry_jumps_removed();
   js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
-  js.update(sdp_state_json(*slam, arena_bytes, arena.used_bytes(), path_gaps, known_cells));
+  js.update(session.state_json(path_gaps, known_cells));
   js["resumed_at_scan"] = resume_at;
   if (extended_after > 0U) {
     js["extended"] = continuation.report().json();
@@ -357,7 +316,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   if (!options.snapshot_path.empty()) {
     js["snapshots"] = {{"written", snapshots},
                        {"file_bytes", snapshot_bytes},
-                       {"state_bytes", slam->state_bytes()},
+                       {"state_bytes", slam.state_bytes()},
                        {"write_ms_max", ms(snapshot_ms_max)}};
   }
   js["timing"] = {{"wall_time_s", ms(wall_s)},
