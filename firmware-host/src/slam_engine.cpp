@@ -6,6 +6,7 @@
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/snapshot_file.h"
+#include "sdpslam/slam/dpslam_session.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/sdp_session.h"
 #include "sdpslam/slam/session_continuation.h"
@@ -52,69 +53,41 @@ PoseSpread spread_of(std::uint32_t n, PoseAt&& pose_at, double turn_rad) {
   return s;
 }
 
-// Committed poses of the filter, kept for the trajectory (capacity reserved up front).
-class PathSink final : public PoseSink {
- public:
-  void on_committed(std::int64_t stamp_us, const Pose2& pose) override {
-    if (poses.size() < poses.capacity()) poses.push_back({stamp_us, pose});
-    else ++dropped;
-  }
-  std::vector<io::StampedPose> poses;
-  std::uint64_t dropped = 0U;
-};
-
+// The bottom-level DP-SLAM filter alone: the session of `sdpslam run --mode dpslam`
+// (runtime/slam dpslam_session.h), fed one scan at a time.
 class DpSlamEngine final : public SlamEngine {
  public:
   bool init(const DaemonConfig& c, std::string* error) {
-    const DpSlamOptions& fo = c.slam.filter;
-    char why[200];
-    if (!fo.validate(why, sizeof why)) {
-      *error = std::string("invalid SLAM options: ") + why;
-      return false;
-    }
-    arena_bytes_ = DpSlamFilter::required_arena_bytes(fo);
-    buffer_.reset(new unsigned char[arena_bytes_]);
-    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
-    filter_ = std::make_unique<DpSlamFilter>();
-    if (!filter_->init(fo, *arena_, c.seed)) {
-      *error = std::string("filter init failed: ") + filter_->why();
-      return false;
-    }
-    sink_.poses.reserve(c.max_trajectory_scans);
-    filter_->set_pose_sink(&sink_);
-    scans_.reserve(c.max_trajectory_scans);
+    if (!session_.create(c.slam.filter, c.seed, error)) return false;
+    session_.reserve_records(c.max_trajectory_scans);
     return true;
   }
 
   const char* name() const override { return "dpslam"; }
 
   EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
-    const StepResult r = filter_->process(odom, scan);
+    const StepResult r = session_.feed(odom, scan);
     EngineStep s;
     s.processed = r.status == StepResult::Status::kProcessed;
     s.pose = r.pose;
-    if (scans_.size() < scans_.capacity()) scans_.push_back(slam::ScanRecord{odom.stamp_us, odom.pose, r.pose, s.processed});
-    else ++unrecorded_;
     return s;
   }
 
   PoseSpread spread() const override {
-    return spread_of(filter_->particle_count(), [this](std::uint32_t i) { return filter_->particle_pose(i); }, 0.0);
+    const DpSlamFilter& filter = session_.filter();
+    return spread_of(filter.particle_count(), [&filter](std::uint32_t i) { return filter.particle_pose(i); }, 0.0);
   }
 
-  std::vector<io::StampedPose> trajectory() const override {
-    std::vector<io::StampedPose> path = sink_.poses;
-    filter_->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
-    return slam::assemble_trajectory(scans_, path, nullptr);
-  }
+  std::vector<io::StampedPose> trajectory() const override { return session_.trajectory(nullptr); }
 
-  std::uint32_t map_image(io::OccupancyImage* image) const override { return slam::best_map_image(*filter_, image); }
+  std::uint32_t map_image(io::OccupancyImage* image) const override { return session_.map_image(image); }
 
   io::Json status_json() const override {
-    const DpSlamStats& st = filter_->stats();
-    const AncestryTree& tree = filter_->tree();
-    const DpMap& map = filter_->map();
-    return {{"particles", filter_->particle_count()},
+    const DpSlamFilter& filter = session_.filter();
+    const DpSlamStats& st = filter.stats();
+    const AncestryTree& tree = filter.tree();
+    const DpMap& map = filter.map();
+    return {{"particles", filter.particle_count()},
             {"processed", st.processed},
             {"resamplings", st.resamplings},
             {"map_updates_dropped", st.map_updates_dropped},
@@ -124,21 +97,15 @@ class DpSlamEngine final : public SlamEngine {
             {"path_entries_exhausted", tree.path_oom_count()},
             {"observations_peak", map.observations_peak()},
             {"observations_capacity", map.observation_capacity()},
-            {"arena_bytes", arena_bytes_},
-            {"committed_poses_dropped", sink_.dropped},
-            {"unrecorded_scans", unrecorded_}};
+            {"arena_bytes", session_.arena_bytes()},
+            {"committed_poses_dropped", session_.committed_dropped()},
+            {"unrecorded_scans", session_.unrecorded()}};
   }
 
-  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+  std::uint64_t unrecorded_scans() const override { return session_.unrecorded(); }
 
  private:
-  std::size_t arena_bytes_ = 0U;
-  std::unique_ptr<unsigned char[]> buffer_;
-  std::unique_ptr<Arena> arena_;
-  std::unique_ptr<DpSlamFilter> filter_;
-  PathSink sink_;
-  std::vector<slam::ScanRecord> scans_;
-  std::uint64_t unrecorded_ = 0U;
+  slam::DpSlamSession session_;
 };
 
 // Segmented DP-SLAM: the session the offline runner runs (runtime/slam sdp_session.h),

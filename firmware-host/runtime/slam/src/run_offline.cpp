@@ -16,17 +16,12 @@
 #include "sdpslam/io/output_set.h"
 #include "sdpslam/io/trajectory_io.h"
 #include "sdpslam/io/json_text.h"
+#include "sdpslam/slam/dpslam_session.h"
 #include "sdpslam/slam/slam_outputs.h"
 #include "run_common.h"
 
 namespace sdpslam::slam {
 namespace {
-
-class CollectSink final : public PoseSink {
- public:
-  void on_committed(std::int64_t stamp_us, const Pose2& pose) override { poses.push_back({stamp_us, pose}); }
-  std::vector<io::StampedPose> poses;
-};
 
 using detail::percentile;
 using detail::rusage_cpu_s;
@@ -54,18 +49,11 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   io::OutputSet outputs;
   if (!outputs.begin(out_dir, error)) return RunStatus::kIoError;
 
-  const std::size_t arena_bytes = dpslam_state_bytes(options);
-  std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
-  Arena arena(buffer.get(), arena_bytes);
-  auto filter = std::make_unique<DpSlamFilter>();
-  if (!filter->init(fo, arena, options.seed)) {
-    *error = std::string("filter init failed: ") + filter->why();
-    return RunStatus::kInternal;
-  }
-  CollectSink sink;
-  filter->set_pose_sink(&sink);
-
-  std::vector<ScanRecord> scans;
+  DpSlamSession session;
+  if (!session.create(fo, options.seed, error)) return RunStatus::kInternal;
+  const DpSlamFilter* filter = &session.filter();
+  const std::size_t arena_bytes = session.arena_bytes();
+  const std::vector<ScanRecord>& scans = session.records();
   std::vector<double> scan_ms;
   std::vector<double> processed_ms;
   std::vector<double> scan_cpu_ms;  // this thread's CPU time: robust on a loaded machine
@@ -75,13 +63,12 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
     const io::LaserRecord& rec = reader.laser();
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = thread_cpu_ms();
-    const StepResult r = filter->process(od, rec.scan);
+    const StepResult r = session.feed(od, rec.scan);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     scan_cpu_ms.push_back(thread_cpu_ms() - c0);
     const bool processed = r.status == StepResult::Status::kProcessed;
     scan_ms.push_back(ms);
     if (processed) processed_ms.push_back(ms);
-    scans.push_back(ScanRecord{rec.stamp_us, od.pose, r.pose, processed});
     if (options.progress) options.progress(reader.input_offset());
   }
   if (scans.empty()) {
@@ -90,15 +77,13 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   }
 
   // The final best particle's path: committed poses, then its own uncommitted ones.
-  std::vector<io::StampedPose> path = sink.poses;
-  filter->for_each_best_pose([&](std::int64_t s, const Pose2& p) { path.push_back({s, p}); });
   std::uint64_t path_gaps = 0U;
-  const std::vector<io::StampedPose> trajectory = assemble_trajectory(scans, path, &path_gaps);
+  const std::vector<io::StampedPose> trajectory = session.trajectory(&path_gaps);
 
   // The best particle's map.
   const DpMap& map = filter->map();
   io::OccupancyImage image;
-  const std::uint32_t known_cells = best_map_image(*filter, &image);
+  const std::uint32_t known_cells = session.map_image(&image);
   if (!write_trajectory_and_map(outputs.staging_dir(), trajectory, image, error, &options.painter)) {
     return RunStatus::kIoError;
   }
