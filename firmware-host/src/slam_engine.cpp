@@ -2,11 +2,11 @@
 
 #include <cmath>
 
-#include "sdpslam/core/arena.h"
 #include "sdpslam/core/bottom/dpslam_filter.h"
 #include "sdpslam/core/sdp_slam.h"
 #include "sdpslam/io/snapshot_file.h"
 #include "sdpslam/slam/dpslam_session.h"
+#include "sdpslam/slam/localize_session.h"
 #include "sdpslam/slam/run_localize.h"
 #include "sdpslam/slam/sdp_session.h"
 #include "sdpslam/slam/session_continuation.h"
@@ -255,82 +255,56 @@ class SdpEngine final : public SlamEngine {
 class LocalizeEngine final : public SlamEngine {
  public:
   bool init(const DaemonConfig& c, std::string* error) {
-    map_ = std::make_unique<slam::LocalizationMap>();
-    if (!slam::load_localization_map(c.localize_map, map_.get(), error)) return false;
-    arena_bytes_ = MonteCarloLocalizer::required_arena_bytes(c.localize, map_->map);
-    if (arena_bytes_ == 0U) {
-      *error = c.localize_map + ": a map the localizer cannot hold (at least 2 x 2 cells, at most 65535 a side)";
+    if (!session_.create(c.localize, c.localize_map, c.seed, c.localize_have_start ? &c.localize_start : nullptr,
+                         kStartSigmaXyM, kStartSigmaThetaRad, error)) {
       return false;
     }
-    buffer_.reset(new unsigned char[arena_bytes_]);
-    arena_ = std::make_unique<Arena>(buffer_.get(), arena_bytes_);
-    mcl_ = std::make_unique<MonteCarloLocalizer>();
-    char why[160];
-    if (!mcl_->init(c.localize, map_->map, *arena_, c.seed, why, sizeof why)) {
-      *error = c.localize_map + ": " + why;
-      return false;
-    }
-    if (c.localize_have_start) {
-      mcl_->start_at(c.localize_start, kStartSigmaXyM, kStartSigmaThetaRad);
-    } else {
-      mcl_->start_global();
-    }
-    poses_.reserve(c.max_trajectory_scans);
+    session_.reserve_records(c.max_trajectory_scans);
     return true;
   }
 
   const char* name() const override { return "localize"; }
 
   EngineStep process(const OdometrySample& odom, const RangeScan& scan) override {
-    const MonteCarloLocalizer::Step r = mcl_->update(odom, scan);
-    if (converged_at_ < 0 && r.updated && r.spread_m < slam::kConvergedSpreadM) {
-      converged_at_ = static_cast<std::int64_t>(mcl_->stats().scans) - 1;
-    }
-    if (poses_.size() < poses_.capacity()) poses_.push_back(io::StampedPose{odom.stamp_us, r.pose});
-    else ++unrecorded_;
+    const MonteCarloLocalizer::Step r = session_.feed(odom, scan);
     return EngineStep{r.updated, r.pose};
   }
 
   // The estimate at each scan as it was given (localization does not revise the past).
   PoseSpread spread() const override {
-    const Pose2* particles = mcl_->particles();
-    return spread_of(mcl_->particle_count(), [particles](std::uint32_t i) { return particles[i]; }, 0.0);
+    const MonteCarloLocalizer& mcl = session_.localizer();
+    const Pose2* particles = mcl.particles();
+    return spread_of(mcl.particle_count(), [particles](std::uint32_t i) { return particles[i]; }, 0.0);
   }
 
-  std::vector<io::StampedPose> trajectory() const override { return poses_; }
+  std::vector<io::StampedPose> trajectory() const override { return session_.trajectory(); }
 
   std::uint32_t map_image(io::OccupancyImage* image) const override {
-    *image = map_->image;
-    return mcl_->stats().free_cells + mcl_->stats().occupied_cells;
+    *image = session_.map().image;
+    return session_.localizer().stats().free_cells + session_.localizer().stats().occupied_cells;
   }
 
   io::Json status_json() const override {
-    const LocalizerStats& st = mcl_->stats();
-    return {{"particles", mcl_->particle_count()},
+    const MonteCarloLocalizer& mcl = session_.localizer();
+    const LocalizerStats& st = mcl.stats();
+    return {{"particles", mcl.particle_count()},
             {"filter_updates", st.filter_updates},
-            {"converged_at_scan", converged_at_},
-            {"spread_m", io::json_fixed(mcl_->spread_m(), 4)},
+            {"converged_at_scan", session_.converged_at()},
+            {"spread_m", io::json_fixed(mcl.spread_m(), 4)},
             {"random_particles", st.random_particles},
             {"kld_capped", st.kld_capped},
-            {"arena_bytes", arena_bytes_},
-            {"unrecorded_scans", unrecorded_}};
+            {"arena_bytes", session_.arena_bytes()},
+            {"unrecorded_scans", session_.unrecorded()}};
   }
 
-  std::uint64_t unrecorded_scans() const override { return unrecorded_; }
+  std::uint64_t unrecorded_scans() const override { return session_.unrecorded(); }
 
  private:
   // The spread of the first particles around a configured start pose (as `sdpslam
   // localize --start`).
   static constexpr double kStartSigmaXyM = 0.25;
   static constexpr double kStartSigmaThetaRad = 0.15;
-  std::unique_ptr<slam::LocalizationMap> map_;
-  std::size_t arena_bytes_ = 0U;
-  std::unique_ptr<unsigned char[]> buffer_;
-  std::unique_ptr<Arena> arena_;
-  std::unique_ptr<MonteCarloLocalizer> mcl_;
-  std::vector<io::StampedPose> poses_;
-  std::int64_t converged_at_ = -1;
-  std::uint64_t unrecorded_ = 0U;
+  slam::LocalizeSession session_;
 };
 
 }  // namespace

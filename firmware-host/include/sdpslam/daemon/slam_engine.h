@@ -4,11 +4,11 @@
 // `sdp` (Segmented DP-SLAM, core/sdp_slam.h, with the [sdp] options) and `localize`
 // (Monte Carlo localization on a saved map, core/localization, with [localize]).
 //
-// dpslam and sdp run the sessions of the offline runner (runtime/slam dpslam_session.h,
-// sdp_session.h: the arena, the engine, what is fed and recorded) and write what it
-// writes from the same state, through the same code (slam_outputs.h): dpslam the best
-// particle's path and map, sdp the best combination's path (permanent segments + live
-// chain) and global map.
+// Each mode runs the session of the offline runner (runtime/slam dpslam_session.h,
+// sdp_session.h, localize_session.h: the arena, the engine, what is fed and recorded)
+// and writes what it writes from the same state, through the same code
+// (slam_outputs.h): dpslam the best particle's path and map, sdp the best combination's
+// path (permanent segments + live chain) and global map, localize the path on its map.
 //
 // An engine owns all of its memory, sized once at create time from the options; process()
 // does not allocate except to append to the scan record and the committed-pose record,

@@ -15,6 +15,7 @@
 #include "sdpslam/io/map_image.h"
 #include "sdpslam/io/map_read.h"
 #include "sdpslam/io/output_set.h"
+#include "sdpslam/slam/localize_session.h"
 #include "sdpslam/slam/slam_outputs.h"
 
 namespace sdpslam::slam {
@@ -83,41 +84,28 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
     *error = std::string("invalid options: localize.") + why;
     return LocalizeStatus::kBadInput;
   }
-  auto loaded = std::make_unique<LocalizationMap>();
-  if (!load_localization_map(map_yaml, loaded.get(), error)) return LocalizeStatus::kBadInput;
-  const io::OccupancyImage& image = loaded->image;
-  const LocalizerMap& map = loaded->map;
+  // The whole state: one arena sized for this map before any scan.
+  LocalizeSession session;
+  if (!session.create(options.localizer, map_yaml, options.seed, options.have_start ? &options.start : nullptr,
+                      options.start_sigma_xy_m, options.start_sigma_theta_rad, error)) {
+    return LocalizeStatus::kBadInput;
+  }
+  const io::OccupancyImage& image = session.map().image;
+  const LocalizerMap& map = session.map().map;
+  const MonteCarloLocalizer* mcl = &session.localizer();
 
   io::LogReader reader;
   if (!reader.open(log_path, options.log, error)) return LocalizeStatus::kBadInput;
   io::OutputSet outputs;
   if (!outputs.begin(out_dir, error)) return LocalizeStatus::kIoError;
 
-  // The whole state: one arena sized for this map before any scan.
-  const std::size_t arena_bytes = MonteCarloLocalizer::required_arena_bytes(options.localizer, map);
-  if (arena_bytes == 0U) {
-    *error = map_yaml + ": a map the localizer cannot hold (at least 2 x 2 cells, at most 65535 a side)";
-    return LocalizeStatus::kBadInput;
-  }
-  std::unique_ptr<unsigned char[]> buffer(new unsigned char[arena_bytes]);
-  Arena arena(buffer.get(), arena_bytes);
-  auto mcl = std::make_unique<MonteCarloLocalizer>();
-  if (!mcl->init(options.localizer, map, arena, options.seed, why, sizeof why)) {
-    *error = map_yaml + ": " + why;
-    return LocalizeStatus::kBadInput;
-  }
-  if (options.have_start) {
-    mcl->start_at(options.start, options.start_sigma_xy_m, options.start_sigma_theta_rad);
-  } else {
-    mcl->start_global();
-  }
+  const std::size_t arena_bytes = session.arena_bytes();
 
   detail::ScanOdometryPairing pairing;
   OdometrySample od;
-  std::vector<io::StampedPose> trajectory;
+  const std::vector<io::StampedPose>& trajectory = session.trajectory();
   std::vector<double> update_ms;
   std::uint64_t skipped = 0U;
-  std::int64_t converged_at = -1;
   double cpu_ms = 0.0;
   while (pairing.next(reader, &od)) {
     if (options.progress) options.progress(reader.input_offset());
@@ -126,14 +114,10 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
       continue;
     }
     const double t0 = thread_cpu_ms();
-    const MonteCarloLocalizer::Step step = mcl->update(od, reader.laser().scan);
+    const MonteCarloLocalizer::Step step = session.feed(od, reader.laser().scan);
     const double dt = thread_cpu_ms() - t0;
     cpu_ms += dt;
     if (step.updated) update_ms.push_back(dt);
-    if (converged_at < 0 && step.updated && step.spread_m < kConvergedSpreadM) {
-      converged_at = static_cast<std::int64_t>(trajectory.size());
-    }
-    trajectory.push_back(io::StampedPose{od.stamp_us, step.pose});
   }
   if (trajectory.empty()) {
     *error = log_path + ": no laser scan with odometry" + (options.skip_scans > 0U ? " after the skipped ones" : "");
@@ -170,7 +154,7 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
   js["skipped_scans"] = skipped;
   js["scans"] = trajectory.size();
   js["filter_updates"] = st.filter_updates;
-  js["converged_at_scan"] = converged_at;
+  js["converged_at_scan"] = session.converged_at();
   js["converged_spread_m"] = fixed(kConvergedSpreadM, 3);
   js["final_spread_m"] = fixed(mcl->spread_m(), 6);
   js["final_particles"] = mcl->particle_count();
@@ -184,7 +168,7 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
                {"free_cells", st.free_cells},
                {"occupied_cells", st.occupied_cells}};
   js["memory"] = {{"arena_bytes", arena_bytes},
-                  {"arena_used_bytes", arena.used_bytes()},
+                  {"arena_used_bytes", session.arena_used_bytes()},
                   {"min_particles", options.localizer.min_particles},
                   {"max_particles", options.localizer.max_particles}};
   js["timing"] = {{"cpu_ms_per_scan_mean", fixed(cpu_ms / static_cast<double>(trajectory.size()), 4)},
@@ -200,7 +184,7 @@ LocalizeStatus run_localize(const std::string& log_path, const std::string& map_
   if (summary != nullptr) {
     summary->scans = trajectory.size();
     summary->updates = st.filter_updates;
-    summary->converged_at_scan = converged_at;
+    summary->converged_at_scan = session.converged_at();
     summary->final_spread_m = mcl->spread_m();
     summary->final_particles = mcl->particle_count();
     summary->state_bytes = arena_bytes;
