@@ -1,8 +1,8 @@
 #pragma once
 // What the offline runners (run_offline.cpp, run_sdp.cpp) share: the log's scans paired
 // with odometry, per-scan CPU time of this thread (meaningful on a loaded machine where
-// wall time is not), and the percentiles and fixed-point text of stats.json. Host-side
-// only (POSIX clock), never in core/.
+// wall time is not), and the percentiles and fixed-point text of stats.json. Used
+// only in the runtime (POSIX clock), never in core/.
 #include <sys/resource.h>
 #include <time.h>
 

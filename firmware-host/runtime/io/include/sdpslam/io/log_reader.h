@@ -1,6 +1,6 @@
 #pragma once
 // Streaming readers of robot logs: CARMEN (.clf, optionally .gz), tinySLAM's one-line-
-// per-scan format, and DP-SLAM's Odometry/Laser format. Host-side (tools/), not core/.
+// per-scan format, and DP-SLAM's Odometry/Laser format. Part of the runtime (POSIX files), not core/.
 //
 // The reader hands out one record at a time and never holds the whole log. A malformed
 // line never stops the read: it is skipped and reported as a LogError naming the file,
