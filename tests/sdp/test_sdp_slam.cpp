@@ -87,6 +87,45 @@ TEST(SdpSlam, check_options_is_the_check_init_makes) {
   CHECK_FALSE(SdpSlam::check_options(b, s, nullptr, 0U));  // why may be null
 }
 
+// The visits take any callable: a const lvalue, a mutable lvalue (called in place, not
+// copied: its own count is the one that grows) and a temporary.
+TEST(SdpSlam, visits_take_const_mutable_and_temporary_callables) {
+  const test::ScanSet set(1);
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), test::small_sdp_options(), 3));
+  test::CollectPoses sink;
+  (void)run_sdp(rig, set, &sink);
+  std::size_t by_const = 0U;
+  const auto count_const = [&by_const](std::int64_t, const Pose2&) { ++by_const; };
+  rig.slam->for_each_best_pose(count_const);
+  CHECK(by_const > 0U);
+  struct Counter {
+    std::size_t n = 0U;
+    void operator()(std::int64_t, const Pose2&) { ++n; }
+  } counter;
+  rig.slam->for_each_best_pose(counter);
+  LONGS_EQUAL(by_const, counter.n);
+  std::size_t by_temporary = 0U;
+  rig.slam->for_each_best_pose([&by_temporary](std::int64_t, const Pose2&) { ++by_temporary; });
+  LONGS_EQUAL(by_const, by_temporary);
+  std::size_t cells_const = 0U;
+  std::size_t cells_mutable = 0U;
+  const auto cell_const = [&cells_const](double, double, const CellObservation&) { ++cells_const; };
+  auto cell_mutable = [&cells_mutable](double, double, const CellObservation&) mutable { ++cells_mutable; };
+  rig.slam->for_each_global_cell(cell_const);
+  rig.slam->for_each_global_cell(cell_mutable);
+  CHECK(cells_const > 0U);
+  LONGS_EQUAL(cells_const, cells_mutable);
+  std::size_t submaps = 0U;
+  const auto submap_const = [&submaps](NodeId, const Pose2&, const CellRect&) { ++submaps; };
+  rig.slam->for_each_best_submap(submap_const);
+  CHECK(submaps > 0U);
+  std::size_t permanent = 0U;
+  const auto permanent_const = [&permanent](double, double, const CellObservation&) { ++permanent; };
+  rig.slam->for_each_permanent_cell(permanent_const);
+  CHECK(permanent <= cells_const);
+}
+
 TEST(SdpSlam, a_long_run_fills_the_pgs_and_makes_old_levels_permanent) {
   const test::ScanSet set(3);
   test::SdpRig rig;

@@ -203,7 +203,7 @@ class SdpSlam {
   // sink). Uses the tree's scratch walk: do not call back into this object from f.
   template <class F>
   void for_each_best_pose(F&& f) const {
-    visit_best_poses(&call<F, std::int64_t, const Pose2&>, &f);
+    visit_best_poses(&call<F, std::int64_t, const Pose2&>, context_of(f));
   }
   // f(node, frame_in_global, rect) for every DP-map view that makes up the best global
   // map besides its permanent part: the permanent submap still being copied (what is
@@ -211,7 +211,7 @@ class SdpSlam {
   // particle; rect bounds the cells worth reading.
   template <class F>
   void for_each_best_submap(F&& f) const {
-    visit_best_submaps(&call<F, NodeId, const Pose2&, const CellRect&>, &f);
+    visit_best_submaps(&call<F, NodeId, const Pose2&, const CellRect&>, context_of(f));
   }
   // f(x_m, y_m, value) for every cell of the global map's permanent part: the centre of
   // the cell in the global frame, moved by the correction its level's frame got since
@@ -222,7 +222,7 @@ class SdpSlam {
   // (SdpSlam test forgotten_permanent_levels_stay_where_they_were_copied).
   template <class F>
   void for_each_permanent_cell(F&& f) const {
-    visit_permanent_cells(&call<F, double, double, const CellObservation&>, &f);
+    visit_permanent_cells(&call<F, double, double, const CellObservation&>, context_of(f));
   }
 
   // ---- the global map, rendered by the caller ------------------------------------------
@@ -241,7 +241,7 @@ class SdpSlam {
   // calls of process(), never from f.
   template <class F>
   void for_each_global_cell(F&& f) const {
-    visit_global_cells(&call<F, double, double, const CellObservation&>, &f);
+    visit_global_cells(&call<F, double, double, const CellObservation&>, context_of(f));
   }
   // The occupancy the observation model gives a cell's (hits, misses).
   double occupancy(const CellObservation& value) const;
@@ -305,7 +305,12 @@ class SdpSlam {
 
  private:
   // The visits above, without templates: fn(context, ...) per item. `context` is the
-  // caller's callable.
+  // caller's callable. A const callable travels as void* and is cast back to its own
+  // const type by call(), so its constness is never lost.
+  template <class F>
+  static void* context_of(F& f) {
+    return const_cast<void*>(static_cast<const void*>(&f));
+  }
   template <class F, class... A>
   static void call(void* context, A... a) {
     (*static_cast<typename std::remove_reference<F>::type*>(context))(a...);
