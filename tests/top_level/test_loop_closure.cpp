@@ -288,6 +288,27 @@ TEST(LoopClosure, the_window_grows_to_the_chains_drift_bound) {
   CHECK_TRUE(distance_m(r.z, truth3) < 0.05);
 }
 
+// The chain put level 3 15.3 m from where it revisits level 0's room, farther than the
+// room's box grown by loop_search_window_m (6 m) reaches, but within the drift bound
+// (loop_search_drift_m = 9 m: 15.6 m over √3 hops) the pair's window grows to. The
+// pair is a candidate because its own window is what grows the box: found (and, being
+// more than half a window away, searched again around its peak before it is kept).
+TEST(LoopClosure, a_submap_beyond_the_base_window_but_within_the_drift_bound_is_a_candidate) {
+  const Pose2 truth3{2.0, 1.0, -0.3};
+  Owner& o = rig->owner;
+  o.levels.push_back({Pose2{}, room()});
+  o.levels.push_back({Pose2{0.0, 60.0, 0.0}, corridor(30.0)});
+  o.levels.push_back({Pose2{0.0, 30.0, 0.0}, corridor(0.0)});
+  o.levels.push_back({truth3.compose(Pose2{15.3, 0.0, 0.05}), seen_from(room(), Pose2{}, truth3)});
+  rig->options.loop_search_drift_m = 9.0;
+  rig->options.loop_search_max_window_m = 16.0;
+  CHECK_TRUE(rig->init());
+  rig->search_all();
+  CHECK_EQUAL(1U, rig->stats.loop_search_recentred_closed);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  check_searched_record(rig->loops.record(0), 0U, 3U, truth3);
+}
+
 // The top level's skeleton match, refined on obstacle points: one record per pair of
 // levels, the lower residual wins; a match that moves the submap farther than
 // loop_max_correction_m from its guess is not kept.

@@ -14,6 +14,12 @@ double widest_window_m(const SdpOptions& s) {
   return s.loop_search_max_window_m > s.loop_search_window_m ? s.loop_search_max_window_m : s.loop_search_window_m;
 }
 
+// A box (x0, y0, x1, y1) grown by `by` on every side.
+struct Box4 {
+  double v[4];
+};
+Box4 grown(const double box[4], double by) { return Box4{{box[0] - by, box[1] - by, box[2] + by, box[3] + by}}; }
+
 std::uint32_t search_steps(const SdpOptions& s, const LoopSearchGeometry& g) {
   return CorrelativeMatcher::steps_for(widest_window_m(s), g.resolution_m, kSearchCoarseCells);
 }
@@ -213,8 +219,10 @@ void LoopClosure::search_step() {
 }
 
 // Older held levels (not adjacent, not already constrained to it) whose boxes in the
-// best combination overlap the newer's box grown by the search window; the
-// loop_search_candidates largest overlaps.
+// best combination overlap the newer's box grown by the window the pair would be
+// searched with (search_window_m: the drift bound between the two, within
+// [loop_search_window_m, loop_search_max_window_m]), so that every submap the search
+// could recover is a candidate; the loop_search_candidates largest overlaps.
 void LoopClosure::search_collect(std::uint32_t newer) {
   search_count_ = 0U;
   search_cursor_ = 0U;
@@ -224,11 +232,8 @@ void LoopClosure::search_collect(std::uint32_t newer) {
   if (!submaps_->placement(newer, &frame, box, &n) || n < options_.loop_min_pairs || !box_valid(box)) return;
   double nb[4];
   box_transform(frame, box, nb);
-  const double w = options_.loop_search_window_m;
-  nb[0] -= w;
-  nb[1] -= w;
-  nb[2] += w;
-  nb[3] += w;
+  // The widest any pair is searched with: a cheap first test before the pair's own.
+  const double widest = widest_window_m(options_);
   double area[SdpOptions::kMaxLoopSearchCandidates];
   const std::uint32_t kmax = options_.loop_search_candidates;
   for (std::uint32_t older = submaps_->first_held_level(); older + 2U <= newer; ++older) {
@@ -243,7 +248,8 @@ void LoopClosure::search_collect(std::uint32_t newer) {
     if (constrained) continue;
     double gb[4];
     box_transform(of, ob, gb);
-    const double a = box_overlap_m2(gb, nb);
+    if (!(box_overlap_m2(gb, grown(nb, widest).v) > 0.0)) continue;
+    const double a = box_overlap_m2(gb, grown(nb, search_window_m(older, newer)).v);
     if (a < options_.min_overlap_m2 || !(a > 0.0)) continue;
     std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
     if (pos == kmax && !(a > area[kmax - 1U])) continue;
