@@ -355,6 +355,7 @@ SdpStepResult SdpSlamImpl::process(const OdometrySample& odom, const RangeScan& 
     ++segment_scans_;
     const std::uint64_t requests = filter_->map().observations_requested() - requested_before;
     if (requests > scan_requests_) scan_requests_ = requests;
+    if (segment_scans_ > 1U && requests > later_scan_requests_) later_scan_requests_ = requests;
     const Pose2 best = filter_->best_pose();
     if (!started_) {
       started_ = true;
@@ -493,6 +494,8 @@ void SdpSlamImpl::segment(std::int64_t stamp_us) {
   segment_scans_ = 0U;
   previous_scan_requests_ = scan_requests_;
   scan_requests_ = 0U;
+  previous_later_scan_requests_ = later_scan_requests_;
+  later_scan_requests_ = 0U;
   segment_observations_released_ = observations_released_;
   segment_observations_used_ = filter_->map().observations_used();
   segment_observations_refused_ = filter_->map().observation_oom_count();
@@ -520,8 +523,11 @@ void SdpSlamImpl::segment(std::int64_t stamp_us) {
 // Room in the bottom level's observation pool (bounded memory): the next segment is
 // expected to need as many observations as the one ending now took (its growth of the
 // pool, not counting what releases of older submaps gave back meanwhile, plus what the
-// pool refused it), and one scan's writes at once on top (the most a scan of this
-// segment or the previous one asked for). While that does not fit
+// pool refused it), and on top what it writes before its first pool check can end it
+// (process(): after its second scan): its first scan, which a restart writes whole into
+// every particle's fresh lineage (the most a scan of this segment or the previous one
+// asked for), and one later scan, whose writes all sit in the pool at once before
+// prune folds them (the most a later scan of either asked for). While that does not fit
 // beside what is held, pending releases are done at once, then the oldest level
 // becomes permanent and is released at once (its observations return to the pool),
 // all of them if need be. Fewer live levels only narrow the top level's choice among
@@ -533,7 +539,9 @@ std::uint64_t SdpSlamImpl::observations_needed() const {
   const DpMap& map = filter_->map();
   const std::uint64_t grown_to = std::uint64_t{map.observations_used()} + (observations_released_ - segment_observations_released_);
   const std::uint64_t grown = grown_to > segment_observations_used_ ? grown_to - segment_observations_used_ : 0U;
-  return grown + (map.observation_oom_count() - segment_observations_refused_) + scan_burst();
+  const std::uint64_t later = later_scan_requests_ > previous_later_scan_requests_ ? later_scan_requests_
+                                                                                   : previous_later_scan_requests_;
+  return grown + (map.observation_oom_count() - segment_observations_refused_) + scan_burst() + later;
 }
 
 void SdpSlamImpl::make_room(std::uint64_t need) {

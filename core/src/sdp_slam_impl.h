@@ -200,9 +200,11 @@ class SdpSlamImpl {
   std::int64_t segment_start_stamp_us_ = 0;  // exclusive
   std::uint32_t segment_scans_ = 0U;  // processed scans in the current segment
   // DP map observations asked for by one processed scan: the most in this segment, and
-  // in the previous one.
+  // in the previous one; the same over the scans after a segment's first (its restart).
   std::uint64_t scan_requests_ = 0U;
   std::uint64_t previous_scan_requests_ = 0U;
+  std::uint64_t later_scan_requests_ = 0U;
+  std::uint64_t previous_later_scan_requests_ = 0U;
   // DP map observations freed by releasing permanent levels' submaps (release_one,
   // transfer_rows), ever; and, when the current segment started, that count and the
   // observations in use and refused then (observations_needed()).

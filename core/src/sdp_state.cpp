@@ -158,6 +158,8 @@ void SdpSlamImpl::transfer_state(StateIo& io) {
   io.value(segment_scans_);
   io.value(scan_requests_);
   io.value(previous_scan_requests_);
+  io.value(later_scan_requests_);
+  io.value(previous_later_scan_requests_);
   io.value(observations_released_);
   io.value(segment_observations_released_);
   io.value(segment_observations_used_);

@@ -682,6 +682,37 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
   CHECK(t.poses.size() > 100U);
 }
 
+// Whatever the pool's size between half of and all that the run's live levels hold at
+// their peak, no map update is refused: a segment starts only with room
+// for its restart (its first scan written whole into every fresh lineage) and the scan
+// after it, before which its own pool check cannot end it.
+TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  std::uint32_t peak = 0U;
+  {
+    SdpOptions ample = s;
+    ample.map_observation_capacity = 2U * s.map_observation_capacity;
+    test::SdpRig rig;
+    CHECK_TRUE(rig.init(test::sim_options(5), ample, 5));
+    test::CollectPoses sink;
+    run_sdp(rig, set, &sink);
+    peak = rig.slam->bottom().map().observations_peak();
+  }
+  std::uint64_t for_room = 0U;
+  for (std::uint32_t k = 0; k < 8U; ++k) {
+    s.map_observation_capacity = peak / 2U + k * (peak - peak / 2U) / 8U;
+    test::SdpRig rig;
+    CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+    test::CollectPoses sink;
+    run_sdp(rig, set, &sink);
+    for_room += rig.slam->stats().levels_made_permanent_for_room;
+    LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+    CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+  }
+  CHECK(for_room > 0U);
+}
+
 TEST(SdpSlam, segslam_topology_runs_the_same_pipeline) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
