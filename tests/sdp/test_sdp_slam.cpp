@@ -644,28 +644,34 @@ TEST(SdpSlam, tiny_capacities_are_counted_and_survived) {
   CHECK(t.poses.size() > 100U);
 }
 
+namespace {
+
+// The peak of the DP map's observation pool over `set` with twice the pool of `s`: room
+// to spare, so that no level goes for room (not even ahead of time, which a pool near
+// full at a segment's peak would ask for) and nothing is refused.
+std::uint32_t pool_peak_with_room_to_spare(const test::ScanSet& set, const SdpOptions& s) {
+  SdpOptions ample = s;
+  ample.map_observation_capacity = 2U * s.map_observation_capacity;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), ample, 5));
+  test::CollectPoses sink;
+  run_sdp(rig, set, &sink);
+  const DpMap& map = rig.slam->bottom().map();
+  LONGS_EQUAL(0, map.observation_oom_count());
+  LONGS_EQUAL(0, rig.slam->stats().levels_made_permanent_for_room);
+  LONGS_EQUAL(0, rig.slam->stats().pool_segmentations);
+  return map.observations_peak();
+}
+
+}  // namespace
+
 // The DP map's observation pool sized at half of what a run's live levels hold at their
 // peak: older levels become permanent early (and a segment ends when the pool cannot
 // take another scan) instead of the pool refusing the current segment's map updates.
 TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_refusing_updates) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
-  std::uint32_t peak = 0U;
-  {
-    // The reference: a pool with room to spare, so that no level goes for room (not even
-    // ahead of time, which a pool near full at a segment's peak would ask for).
-    SdpOptions ample = s;
-    ample.map_observation_capacity = 2U * s.map_observation_capacity;
-    test::SdpRig rig;
-    CHECK_TRUE(rig.init(test::sim_options(5), ample, 5));
-    test::CollectPoses sink;
-    run_sdp(rig, set, &sink);
-    const DpMap& map = rig.slam->bottom().map();
-    peak = map.observations_peak();
-    LONGS_EQUAL(0, map.observation_oom_count());
-    LONGS_EQUAL(0, rig.slam->stats().levels_made_permanent_for_room);
-    LONGS_EQUAL(0, rig.slam->stats().pool_segmentations);
-  }
+  const std::uint32_t peak = pool_peak_with_room_to_spare(set, s);
   s.map_observation_capacity = peak / 2U;
   test::SdpRig rig;
   CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
@@ -683,22 +689,13 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
 }
 
 // Whatever the pool's size between half of and all that the run's live levels hold at
-// their peak, no map update is refused: a segment starts only with room
-// for its restart (its first scan written whole into every fresh lineage) and the scan
-// after it, before which its own pool check cannot end it.
+// their peak, no map update is refused: a segment starts only with room for its restart
+// (its first scan written whole into every fresh lineage) and the scan after it, before
+// which its own pool check cannot end it.
 TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
-  std::uint32_t peak = 0U;
-  {
-    SdpOptions ample = s;
-    ample.map_observation_capacity = 2U * s.map_observation_capacity;
-    test::SdpRig rig;
-    CHECK_TRUE(rig.init(test::sim_options(5), ample, 5));
-    test::CollectPoses sink;
-    run_sdp(rig, set, &sink);
-    peak = rig.slam->bottom().map().observations_peak();
-  }
+  const std::uint32_t peak = pool_peak_with_room_to_spare(set, s);
   std::uint64_t for_room = 0U;
   for (std::uint32_t k = 0; k < 8U; ++k) {
     s.map_observation_capacity = peak / 2U + k * (peak - peak / 2U) / 8U;
