@@ -151,8 +151,9 @@ struct SdpOptions {
   // converges when the chain already placed the two submaps within a few decimetres;
   // after a long loop it is metres off. So once per level, the best combination's
   // submap is searched against up to loop_search_candidates older, non-adjacent
-  // submaps whose boxes, grown by loop_search_window_m, overlap its own: exhaustively
-  // within ±loop_search_window_m and ±loop_search_window_rad on their obstacle points;
+  // submaps whose boxes, grown by the window the pair is searched with (below), overlap
+  // its own: exhaustively within ±loop_search_window_m and ±loop_search_window_rad on
+  // their obstacle points;
   // an unambiguous peak (mean likelihood >= loop_search_min_score over the newer
   // submap's points that fall on the older one's grid, at least loop_min_pairs of
   // them: two submaps overlap in part; no distinct peak
