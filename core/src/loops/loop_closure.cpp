@@ -14,12 +14,6 @@ double widest_window_m(const SdpOptions& s) {
   return s.loop_search_max_window_m > s.loop_search_window_m ? s.loop_search_max_window_m : s.loop_search_window_m;
 }
 
-// A box (x0, y0, x1, y1) grown by `by` on every side.
-struct Box4 {
-  double v[4];
-};
-Box4 grown(const double box[4], double by) { return Box4{{box[0] - by, box[1] - by, box[2] + by, box[3] + by}}; }
-
 std::uint32_t search_steps(const SdpOptions& s, const LoopSearchGeometry& g) {
   return CorrelativeMatcher::steps_for(widest_window_m(s), g.resolution_m, kSearchCoarseCells);
 }
@@ -248,8 +242,11 @@ void LoopClosure::search_collect(std::uint32_t newer) {
     if (constrained) continue;
     double gb[4];
     box_transform(of, ob, gb);
-    if (!(box_overlap_m2(gb, grown(nb, widest).v) > 0.0)) continue;
-    const double a = box_overlap_m2(gb, grown(nb, search_window_m(older, newer)).v);
+    double grown[4];
+    box_grow(nb, widest, grown);
+    if (!(box_overlap_m2(gb, grown) > 0.0)) continue;
+    box_grow(nb, search_window_m(older, newer), grown);
+    const double a = box_overlap_m2(gb, grown);
     if (a < options_.min_overlap_m2 || !(a > 0.0)) continue;
     std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
     if (pos == kmax && !(a > area[kmax - 1U])) continue;

@@ -81,10 +81,7 @@ void CombinationEvaluator::evaluate(const SubmapStore& store, std::uint32_t firs
       continue;
     }
     box_transform(frames[i], sm.box, gbox[i]);
-    gbox[i][0] -= m;
-    gbox[i][1] -= m;
-    gbox[i][2] += m;
-    gbox[i][3] += m;
+    box_grow(gbox[i], m, gbox[i]);
   }
   for (std::uint32_t j = 0; j < count; ++j) {
     if (!box_valid(gbox[j])) continue;

@@ -37,6 +37,14 @@ inline void box_transform(const Pose2& frame, const double b[4], double out[4]) 
   }
 }
 
+// Box `b` grown by `by_m` on every side, into `out` (which may be `b`).
+inline void box_grow(const double b[4], double by_m, double out[4]) {
+  out[0] = b[0] - by_m;
+  out[1] = b[1] - by_m;
+  out[2] = b[2] + by_m;
+  out[3] = b[3] + by_m;
+}
+
 // Area (m²) of the overlap of two boxes; 0 when they do not overlap.
 inline double box_overlap_m2(const double a[4], const double b[4]) {
   const double x0 = a[0] > b[0] ? a[0] : b[0];
