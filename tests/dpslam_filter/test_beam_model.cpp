@@ -111,6 +111,52 @@ TEST(BeamModel, beams_leaving_the_map_are_counted_as_dropped_not_fatal) {
   CHECK_TRUE(f.map.invariants_hold());
 }
 
+// cells_bound() and cells_bound_at() are upper bounds on the new observations
+// update_map() takes, the first at any pose and heading (it does not know the pose),
+// and close enough to be of use: the first within twice what a dense fan of beams
+// writes; the second within 5 % of what the room's scan writes, and within 1.6 times on
+// fans whose ranges jump from beam to beam (a short beam between two long ones hides
+// the cells they share).
+TEST(BeamModel, the_cells_bounds_hold_at_every_pose_and_are_tight) {
+  std::uint32_t state = 12345U;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 1664525U + 1013904223U;
+    return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
+  };
+  const auto world = test::room_world();
+  for (std::uint32_t trial = 0; trial < 40U; ++trial) {
+    MapFixture f;
+    const Pose2 pose{uniform(1.0, 9.0), uniform(1.0, 4.0), uniform(-3.14, 3.14)};
+    if (trial % 2U == 0U) {
+      test::make_scan(world, pose, 0, f.scan.get());
+    } else {
+      // a dense fan: every beam of a 270-degree 1081-beam laser, ranges to 6 m, some
+      // beyond max_update_range_m's stand-in (range_max_m: no return)
+      f.scan->geometry.angle_min_rad = -2.356F;
+      f.scan->geometry.angle_increment_rad = 0.004363F;
+      f.scan->geometry.range_min_m = 0.1F;
+      f.scan->geometry.range_max_m = 5.5F;
+      f.scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
+      for (std::uint32_t b = 0; b < f.scan->beam_count; ++b) f.scan->ranges_m[b] = static_cast<float>(uniform(0.2, 6.0));
+    }
+    prepare_rays(*f.scan, f.rays.get());
+    const std::uint32_t before = f.map.observations_used();
+    LONGS_EQUAL(0, f.beam.update_map(f.map, f.root, *f.rays, pose));
+    const std::uint64_t written = f.map.observations_used() - before;
+    const std::uint64_t bound = f.beam.cells_bound(*f.rays);
+    const std::uint64_t at = f.beam.cells_bound_at(f.map, *f.rays, pose);
+    CHECK(written > 0U);
+    CHECK(bound >= written);
+    CHECK(at >= written);
+    if (trial % 2U == 1U) {
+      CHECK(bound <= 2U * written);
+      CHECK(5U * at <= 8U * written);
+    } else if (written > 1000U) {
+      CHECK(20U * at <= 21U * written);  // ranges vary smoothly along a real scan
+    }
+  }
+}
+
 TEST(BeamModel, invalid_options_are_refused) {
   BeamModel b;
   BeamModelOptions o;

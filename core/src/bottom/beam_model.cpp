@@ -16,21 +16,25 @@ std::int32_t floor_cell(double v) {
   return static_cast<std::int32_t>(i);
 }
 
-// Integer Bresenham from (x0, y0) to (x1, y1) inclusive; f(ix, iy, last) returns false
-// to stop early.
-template <class F>
-void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1, F&& f) {
-  const std::int64_t dx = x1 >= x0 ? static_cast<std::int64_t>(x1) - x0 : static_cast<std::int64_t>(x0) - x1;
-  const std::int64_t dy = y1 >= y0 ? static_cast<std::int64_t>(y1) - y0 : static_cast<std::int64_t>(y0) - y1;
-  const std::int32_t sx = x0 < x1 ? 1 : -1;
-  const std::int32_t sy = y0 < y1 ? 1 : -1;
-  std::int64_t err = dx - dy;
-  std::int32_t x = x0;
-  std::int32_t y = y0;
+// Integer Bresenham from (x0, y0) to (x1, y1) inclusive, one cell at a time: every step
+// moves one cell along the longer axis (and at most one along the other).
+struct Bresenham {
+  std::int64_t dx, dy, err;
+  std::int32_t sx, sy, x, y, x1, y1;
+  Bresenham(std::int32_t x0, std::int32_t y0, std::int32_t to_x, std::int32_t to_y)
+      : dx(to_x >= x0 ? static_cast<std::int64_t>(to_x) - x0 : static_cast<std::int64_t>(x0) - to_x),
+        dy(to_y >= y0 ? static_cast<std::int64_t>(to_y) - y0 : static_cast<std::int64_t>(y0) - to_y),
+        err(dx - dy),
+        sx(x0 < to_x ? 1 : -1),
+        sy(y0 < to_y ? 1 : -1),
+        x(x0),
+        y(y0),
+        x1(to_x),
+        y1(to_y) {}
+  bool last() const { return x == x1 && y == y1; }
   // A beam is at most a few thousand cells long; the bound guards against garbage input.
-  for (std::int64_t guard = 0; guard <= dx + dy + 1; ++guard) {
-    const bool last = (x == x1 && y == y1);
-    if (!f(x, y, last) || last) return;
+  std::int64_t steps_bound() const { return dx + dy + 1; }
+  void step() {
     const std::int64_t e2 = 2 * err;
     if (e2 > -dy) {
       err -= dy;
@@ -41,6 +45,33 @@ void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t
       y += sy;
     }
   }
+};
+
+// f(ix, iy, last) for every cell from (x0, y0) to (x1, y1); f returns false to stop early.
+template <class F>
+void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1, F&& f) {
+  Bresenham line(x0, y0, x1, y1);
+  for (std::int64_t guard = 0; guard <= line.steps_bound(); ++guard) {
+    const bool last = line.last();
+    if (!f(line.x, line.y, last) || last) return;
+    line.step();
+  }
+}
+
+// Cells two lines from one start cell share step for step (the same cell at the same step).
+std::uint64_t shared_cells(std::int32_t x0, std::int32_t y0, std::int32_t ax, std::int32_t ay, std::int32_t bx,
+                           std::int32_t by) {
+  Bresenham a(x0, y0, ax, ay);
+  Bresenham b(x0, y0, bx, by);
+  std::uint64_t shared = 0U;
+  const std::int64_t guard_end = a.steps_bound() < b.steps_bound() ? a.steps_bound() : b.steps_bound();
+  for (std::int64_t guard = 0; guard <= guard_end; ++guard) {
+    if (a.x == b.x && a.y == b.y) ++shared;
+    if (a.last() || b.last()) break;
+    a.step();
+    b.step();
+  }
+  return shared;
 }
 
 inline double mantissa_and_exponent(double v, std::int64_t* exponent) {
@@ -205,40 +236,113 @@ double BeamModel::likelihood(const DpMap& map, const ScanRays& rays, const Pose2
   return ll / options_.likelihood_temperature;
 }
 
-std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
-  const LaserFrame lf = laser_frame(rays, robot);
-  const double inv_res = 1.0 / resolution_m_;
-  const double ox = map.options().origin_x_m;
-  const double oy = map.options().origin_y_m;
-  const std::int32_t lx = floor_cell((lf.x_m - ox) * inv_res);
-  const std::int32_t ly = floor_cell((lf.y_m - oy) * inv_res);
-  std::uint32_t dropped = 0U;
-  for (std::uint32_t b = 0; b < rays.count; ++b) {
+// The cells update_map() traces: from the laser's cell to each beam's end cell.
+struct BeamModel::Tracer {
+  LaserFrame lf;
+  double inv_res, ox, oy;
+  std::int32_t lx, ly;
+  Tracer(const BeamModel& m, const DpMap& map, const ScanRays& rays, const Pose2& robot)
+      : lf(laser_frame(rays, robot)),
+        inv_res(1.0 / m.resolution_m_),
+        ox(map.options().origin_x_m),
+        oy(map.options().origin_y_m),
+        lx(floor_cell((lf.x_m - ox) * inv_res)),
+        ly(floor_cell((lf.y_m - oy) * inv_res)) {}
+  // Beam b's end cell and whether it is a hit; false iff the beam traces nothing.
+  bool end_cell(const BeamModel& m, const ScanRays& rays, std::uint32_t b, std::int32_t* ex, std::int32_t* ey,
+                bool* hit) const {
     double end_m;
-    bool hit;
-    const auto kind = static_cast<RangeScan::Beam>(rays.kind[b]);
-    if (kind == RangeScan::Beam::kReturn) {
-      const double r = static_cast<double>(rays.range_m[b]);
-      hit = r <= options_.max_update_range_m;
-      end_m = hit ? r : options_.max_update_range_m;
-    } else if (kind == RangeScan::Beam::kNoReturn && options_.no_return_free_m > 0.0) {
-      hit = false;
-      end_m = options_.no_return_free_m < options_.max_update_range_m ? options_.no_return_free_m
-                                                                         : options_.max_update_range_m;
-    } else {
-      continue;
+    if (!m.traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), &end_m, hit)) {
+      return false;
     }
     const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
     const double dy = lf.s * rays.cos_a[b] + lf.c * rays.sin_a[b];
-    const std::int32_t ex = floor_cell((lf.x_m + end_m * dx - ox) * inv_res);
-    const std::int32_t ey = floor_cell((lf.y_m + end_m * dy - oy) * inv_res);
-    trace_cells(lx, ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
+    *ex = floor_cell((lf.x_m + end_m * dx - ox) * inv_res);
+    *ey = floor_cell((lf.y_m + end_m * dy - oy) * inv_res);
+    return true;
+  }
+};
+
+std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
+  const Tracer t(*this, map, rays, robot);
+  std::uint32_t dropped = 0U;
+  for (std::uint32_t b = 0; b < rays.count; ++b) {
+    std::int32_t ex;
+    std::int32_t ey;
+    bool hit;
+    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
+    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
       const bool ok = (last && hit) ? map.add(particle, ix, iy, 1U, 0U) : map.add(particle, ix, iy, 0U, 1U);
       if (!ok) ++dropped;
       return true;
     });
   }
   return dropped;
+}
+
+std::uint64_t BeamModel::cells_bound_at(const DpMap& map, const ScanRays& rays, const Pose2& robot) const {
+  const Tracer t(*this, map, rays, robot);
+  std::uint64_t cells = 0U;
+  bool previous = false;
+  std::int32_t px = 0;
+  std::int32_t py = 0;
+  for (std::uint32_t b = 0; b < rays.count; ++b) {
+    std::int32_t ex;
+    std::int32_t ey;
+    bool hit;
+    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
+    const std::int64_t ax = ex >= t.lx ? static_cast<std::int64_t>(ex) - t.lx : static_cast<std::int64_t>(t.lx) - ex;
+    const std::int64_t ay = ey >= t.ly ? static_cast<std::int64_t>(ey) - t.ly : static_cast<std::int64_t>(t.ly) - ey;
+    cells += static_cast<std::uint64_t>(ax > ay ? ax : ay) + 1U;
+    if (previous) cells -= shared_cells(t.lx, t.ly, px, py, ex, ey);
+    px = ex;
+    py = ey;
+    previous = true;
+  }
+  return cells;
+}
+
+bool BeamModel::traced_m(RangeScan::Beam kind, double range_m, double* end_m, bool* hit) const {
+  if (kind == RangeScan::Beam::kReturn) {
+    *hit = range_m <= options_.max_update_range_m;
+    *end_m = *hit ? range_m : options_.max_update_range_m;
+    return true;
+  }
+  if (kind == RangeScan::Beam::kNoReturn && options_.no_return_free_m > 0.0) {
+    *hit = false;
+    *end_m = options_.no_return_free_m < options_.max_update_range_m ? options_.no_return_free_m
+                                                                       : options_.max_update_range_m;
+    return true;
+  }
+  return false;
+}
+
+std::uint64_t BeamModel::cells_bound(const ScanRays& rays) const {
+  // Past k = beams / 8 the square grows faster than the beams' tails shrink ((2k + 1)^2
+  // grows by 8k + 8, the tails by at most the number of beams), so the least is below.
+  constexpr std::uint32_t kMaxK = capacity::kMaxBeams / 8U + 1U;
+  // at_least[j]: beams tracing at least j cells (j = kMaxK + 1 counts all longer ones).
+  std::uint32_t at_least[kMaxK + 2U] = {};
+  std::uint64_t tail = 0U;  // sum over beams of cells - 1 (k = 0)
+  for (std::uint32_t b = 0; b < rays.count; ++b) {
+    double end_m;
+    bool hit;
+    if (!traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), &end_m, &hit)) {
+      continue;
+    }
+    const auto cells = static_cast<std::uint64_t>(end_m / resolution_m_) + 3U;
+    tail += cells - 1U;
+    ++at_least[cells < kMaxK + 1U ? cells : kMaxK + 1U];
+  }
+  for (std::uint32_t j = kMaxK + 1U; j > 0U; --j) at_least[j - 1U] += at_least[j];
+  std::uint64_t best = 1U + tail;
+  for (std::uint32_t k = 1U; k <= kMaxK; ++k) {
+    tail -= at_least[k + 1U];  // each beam of at least k + 1 cells leaves one more inside
+    const std::uint64_t side = 2U * std::uint64_t{k} + 1U;
+    const std::uint64_t bound = side * side + tail;
+    if (bound < best) best = bound;
+  }
+  return best;
 }
 
 }  // namespace sdpslam

@@ -94,6 +94,21 @@ class BeamModel {
   // Writes the scan into `particle`'s map. Returns the number of cell updates the map
   // dropped (0 normally).
   std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const;
+  // Upper bounds on the distinct cells update_map() writes, so on the new observations
+  // one particle's update takes from the pool (its node is fresh). Bresenham moves one
+  // cell along the longer axis per step, so a beam's d-th cell lies on the square ring
+  // d cells around the laser's cell, and a beam traced to `end` has at most
+  // floor(end / cell) + 3 cells (+1 for each end's rounding to a cell, +1 for
+  // floating-point rounding).
+  // - At any pose: the first k + 1 cells of every beam lie within the (2k + 1)^2 square,
+  //   so the scan covers at most (2k + 1)^2 + sum over beams of max(0, cells - k - 1),
+  //   taken at the k that makes it least. O(beams).
+  std::uint64_t cells_bound(const ScanRays& rays) const;
+  // - At `robot`, exactly as update_map() traces: every beam's cells, less the cells it
+  //   shares, step for step, with the next traced beam (beams in scan order sharing a cell
+  //   on a ring are one cell, and a cell shared by a chain of them is counted once per
+  //   chain). The lines are traced twice, without touching the map: O(cells).
+  std::uint64_t cells_bound_at(const DpMap& map, const ScanRays& rays, const Pose2& robot) const;
 
   // Stopping probability of a cell with these counts (the LUT the hot path uses).
   double stop_probability(const CellObservation& c) const;
@@ -101,6 +116,10 @@ class BeamModel {
 
  private:
   double gauss_mass(double abs_error_m) const;
+  // How far update_map() traces a beam of this kind and range, and whether it ends in a
+  // hit; false iff it traces nothing.
+  bool traced_m(RangeScan::Beam kind, double range_m, double* end_m, bool* hit) const;
+  struct Tracer;
   template <class Lookup>
   double likelihood(const DpMap& map, const ScanRays& rays, const Pose2& robot, std::uint32_t stride,
                     BeamScore* score, Lookup&& lookup) const;
