@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "filter_harness.h"
 
@@ -207,6 +208,79 @@ TEST(DpSlamFilter, tiny_capacities_degrade_counted_without_crash_or_corruption) 
   CHECK(rig.filter->map().observation_oom_count() + rig.filter->map().tile_oom_count() > 0U);
   CHECK(rig.filter->tree().path_oom_count() > 0U);
   CHECK(rig.filter->map().observations_used() <= rig.filter->map().observation_capacity());
+}
+
+namespace {
+// Records what the filter asks; frees nothing (a filter alone holds no anchored nodes).
+class RecordingRoom final : public MapRoom {
+ public:
+  explicit RecordingRoom(const DpMap& map) : map_(map) {}
+  void make_room(std::uint64_t observations) override {
+    ++asked;
+    need = observations;
+    free_then = map_.observation_capacity() - map_.observations_used();
+  }
+  std::uint32_t asked = 0U;
+  std::uint64_t need = 0U;
+  std::uint64_t free_then = 0U;
+
+ private:
+  const DpMap& map_;
+};
+}  // namespace
+
+// Before its map writes the filter asks its MapRoom for room exactly where the pool's
+// free room may not hold them, and for no less than they take: a step that does not ask
+// has nothing refused, and a step asks only with less room free than it asks for. What
+// the writes take is measured on a twin run with an ample pool, identical step for step
+// until the tight pool first refuses an update. With the pool ample it never asks.
+TEST(DpSlamFilter, a_map_room_is_asked_before_writes_the_pool_may_not_hold_and_for_no_less) {
+  const test::SimRun run = test::make_loop();
+  const auto world = test::room_world();
+  const auto options = [](std::uint32_t capacity) {
+    DpSlamOptions o = test::sim_options(6);
+    o.map_observations_per_particle = 1000U;
+    o.map_observations_base = capacity - 6U * o.map_observations_per_particle;
+    return o;
+  };
+  std::vector<std::uint64_t> takes;  // per step, on the ample pool
+  {
+    FilterRig rig;
+    CHECK_TRUE(rig.init(options(400000U), 5));
+    RecordingRoom room(rig.filter->map());
+    rig.filter->set_map_room(&room);
+    for (std::size_t i = 0; i < run.truth.size(); ++i) {
+      const std::uint64_t before = rig.filter->map().observations_requested();
+      rig.step(run, world, i);
+      takes.push_back(rig.filter->map().observations_requested() - before);
+    }
+    LONGS_EQUAL(0, room.asked);
+    LONGS_EQUAL(0, rig.filter->map().observation_oom_count());
+  }
+  FilterRig rig;
+  CHECK_TRUE(rig.init(options(40000U), 5));
+  const DpMap& map = rig.filter->map();
+  RecordingRoom room(map);
+  rig.filter->set_map_room(&room);
+  std::uint32_t compared = 0U;
+  for (std::size_t i = 0; i < run.truth.size(); ++i) {
+    const std::uint32_t asked_before = room.asked;
+    const std::uint64_t refused_before = map.observation_oom_count();
+    rig.step(run, world, i);
+    if (room.asked == asked_before) {
+      LONGS_EQUAL(refused_before, map.observation_oom_count());
+    } else {
+      CHECK(room.free_then < room.need);
+      if (refused_before == 0U) {
+        CHECK(takes[i] <= room.need);
+        ++compared;
+      }
+    }
+  }
+  CHECK(compared > 0U);
+  CHECK(map.observation_oom_count() > 0U);  // this room frees nothing
+  LONGS_EQUAL(room.asked, rig.filter->stats().map_room_asked);
+  LONGS_EQUAL(room.asked, rig.filter->stats().map_room_short);
 }
 
 TEST(DpSlamFilter, best_path_ends_at_the_best_pose) {

@@ -219,14 +219,10 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   for (std::uint32_t m = 0; m < n; ++m) ++counts_[drawn_[m]];
   // 4. map update and path of every surviving particle (once per node: duplicates
   //    become children that inherit it).
+  if (room_ != nullptr) ask_room_for_writes();
   std::uint32_t dropped = 0U;
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (counts_[i] == 0U) continue;
-    bool seen = false;  // a node shared by several particles (fallback) is updated once
-    for (std::uint32_t j = 0; j < i && !seen; ++j) {
-      seen = counts_[j] > 0U && particles_[j].node == particles_[i].node;
-    }
-    if (seen) continue;
+    if (!writes(i)) continue;
     dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i]);
     tree_.append_pose(particles_[i].node, scan.stamp_us, proposed_[i]);
   }
@@ -337,18 +333,13 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
     ++restart_refused_count_;
     return false;
   }
-  const NodeId root = tree_.create_root();
-  if (root == kNoNode) {
-    ++restart_refused_count_;
-    return false;
-  }
   // The previous scans go where the best particle's lineage put them, relative to
   // start_pose as they were to its pose (a scan whose pose the lineage no longer holds,
   // e.g. one from before the last restart, is left out).
+  Pose2 at[kSeedScans];
+  bool found[kSeedScans] = {};
   if (seed_count_ > 0U) {
     const Pose2 best_inverse = particles_[best_index_].pose.inverse();
-    Pose2 at[kSeedScans];
-    bool found[kSeedScans] = {};
     for (std::uint32_t k = 0; k < seed_count_; ++k) {
       at[k] = seed_pose_[k];  // committed: on every lineage
       found[k] = seed_committed_[k];
@@ -361,12 +352,28 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
         }
       }
     });
-    for (std::uint32_t k = 0; k < seed_count_; ++k) {
-      if (found[k]) {
-        stats_.map_updates_dropped +=
-            beam_.update_map(map_, root, seed_rays_[k], start_pose.compose(best_inverse.compose(at[k])));
+    for (std::uint32_t k = 0; k < seed_count_; ++k) at[k] = start_pose.compose(best_inverse.compose(at[k]));
+  }
+  // Room for the root's writes (MapRoom), asked before the root exists: making room
+  // prunes the tree.
+  if (room_ != nullptr) {
+    std::uint64_t quick = beam_.cells_bound(rays_);
+    for (std::uint32_t k = 0; k < seed_count_; ++k) quick += found[k] ? beam_.cells_bound(seed_rays_[k]) : 0U;
+    if (quick > free_observations()) {
+      std::uint64_t need = beam_.cells_bound_at(map_, rays_, start_pose);
+      for (std::uint32_t k = 0; k < seed_count_; ++k) {
+        need += found[k] ? beam_.cells_bound_at(map_, seed_rays_[k], at[k]) : 0U;
       }
+      ask_room(need);
     }
+  }
+  const NodeId root = tree_.create_root();
+  if (root == kNoNode) {
+    ++restart_refused_count_;
+    return false;
+  }
+  for (std::uint32_t k = 0; k < seed_count_; ++k) {
+    if (found[k]) stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k]);
   }
   stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose);
   seed_count_ = 0U;  // the next segment starts from its own scans
@@ -385,6 +392,42 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
   best_index_ = 0U;
   last_best_pose_ = start_pose;
   return true;
+}
+
+// Particle i survives resampling and is the first with its node (a node shared by
+// several particles, a fallback, is updated once).
+bool DpSlamFilter::writes(std::uint32_t i) const {
+  if (counts_[i] == 0U) return false;
+  for (std::uint32_t j = 0; j < i; ++j) {
+    if (counts_[j] > 0U && particles_[j].node == particles_[i].node) return false;
+  }
+  return true;
+}
+
+// The writers are the surviving particles, one per node (step 4). Every writer's node is
+// a fresh leaf (or, degraded, its parent's node), so it takes at most one new
+// observation per cell its scan traces. The bound at any pose is checked first (O(beams));
+// only where the pool is that tight are the writers' scans traced at their poses.
+void DpSlamFilter::ask_room_for_writes() {
+  std::uint32_t writers = 0U;
+  for (std::uint32_t i = 0; i < particle_count_; ++i) writers += writes(i) ? 1U : 0U;
+  if (std::uint64_t{writers} * beam_.cells_bound(rays_) <= free_observations()) return;
+  std::uint64_t need = 0U;
+  for (std::uint32_t i = 0; i < particle_count_; ++i) {
+    if (writes(i)) need += beam_.cells_bound_at(map_, rays_, proposed_[i]);
+  }
+  ask_room(need);
+}
+
+std::uint64_t DpSlamFilter::free_observations() const {
+  return std::uint64_t{map_.observation_capacity()} - map_.observations_used();
+}
+
+void DpSlamFilter::ask_room(std::uint64_t need) {
+  if (room_ == nullptr || need <= free_observations()) return;
+  ++stats_.map_room_asked;
+  room_->make_room(need);
+  if (free_observations() < need) ++stats_.map_room_short;
 }
 
 bool DpSlamFilter::release_anchored(NodeId node) {

@@ -181,7 +181,9 @@ io::Json filter_pools_json(const DpSlamFilter& filter) {
                         {"exhausted", tree.path_oom_count()}};
   js["observations"] = {{"capacity", map.observation_capacity()},
                         {"peak", map.observations_peak()},
-                        {"exhausted", map.observation_oom_count()}};
+                        {"exhausted", map.observation_oom_count()},
+                        {"room_asked", filter.stats().map_room_asked},
+                        {"room_short", filter.stats().map_room_short}};
   js["tiles"] = {{"capacity", map.tile_capacity()}, {"peak", map.tiles_peak()}, {"exhausted", map.tile_oom_count()}};
   return js;
 }

@@ -13,7 +13,9 @@
 //   4. map update: every particle that survives resampling writes the scan into its own
 //      ancestry node's observations (hits at end points, misses along rays) and records
 //      its pose on that node's path; then every drawn particle becomes a new child node
-//      (duplicates of one particle become siblings that inherit the same map);
+//      (duplicates of one particle become siblings that inherit the same map). Where the
+//      pool's free room may not hold the writes (BeamModel's bounds), a MapRoom is
+//      first asked to make room;
 //   5. prune/merge the ancestry tree (the DP map follows through TreeListener) and
 //      drain the poses every particle agrees on to the PoseSink.
 // A scan is processed only once the odometry has moved update_min_travel_m or turned
@@ -63,6 +65,20 @@ struct StepResult {
   std::uint32_t poses_committed = 0U;      // this step
 };
 
+// Asked for room in the map's observation pool before a step's map writes (step 4),
+// which all sit in the pool at once until prune folds them into the lineages, and
+// before a restart writes the last scans into the new root (restart_segment()). It may
+// free the observations of nodes no particle descends from (release_anchored()) and
+// read the map; it must not process scans, restart or displace the filter.
+class MapRoom {
+ public:
+  // Make room, if it can, for `observations` more than the pool holds now.
+  virtual void make_room(std::uint64_t observations) = 0;
+
+ protected:
+  ~MapRoom() = default;
+};
+
 struct DpSlamStats {
   std::uint64_t scans = 0U;
   std::uint64_t processed = 0U;
@@ -76,6 +92,9 @@ struct DpSlamStats {
   std::uint64_t proposal_fallback_empty_map = 0U;   // ... map too empty at the prediction
   std::uint64_t proposal_fallback_low_score = 0U;   // ... match scored below the threshold
   std::uint64_t proposal_evaluations = 0U;          // observation-model calls by the matcher
+  // Steps whose map writes might not have fitted in the pool's free room (MapRoom):
+  std::uint64_t map_room_asked = 0U;    // ... and the MapRoom was asked for room
+  std::uint64_t map_room_short = 0U;    // ... and there was still not room enough after
 };
 
 class DpSlamFilter {
@@ -98,6 +117,9 @@ class DpSlamFilter {
 
   // Receives poses every particle agrees on (committed). May be null. Not owned.
   void set_pose_sink(PoseSink* sink) { sink_ = sink; }
+  // Asked for room before a step's map writes could be refused (MapRoom). May be null
+  // (writes the pool cannot take are then dropped and counted). Not owned.
+  void set_map_room(MapRoom* room) { room_ = room; }
 
   // ---- the best particle -------------------------------------------------------------
   // Highest-weight particle of the last processed step (its node is a current leaf).
@@ -169,6 +191,14 @@ class DpSlamFilter {
   // the log-weight increment.
   double propose(std::uint32_t i, const Pose2& odom_delta);
   bool is_particle_node(NodeId node) const;
+  // Before step 4: the writers' scans at their proposed poses, bounded, and room asked
+  // for them where the pool's free room may not hold them.
+  void ask_room_for_writes();
+  // Asks room_ for `need` observations beyond those in use where fewer are free.
+  void ask_room(std::uint64_t need);
+  std::uint64_t free_observations() const;
+  // Step 4 writes particle i's scan into its node.
+  bool writes(std::uint32_t i) const;
 
   DpSlamOptions options_{};
   AncestryTree tree_;
@@ -178,6 +208,7 @@ class DpSlamFilter {
   MotionModel motion_;
   Rng rng_;
   PoseSink* sink_ = nullptr;
+  MapRoom* room_ = nullptr;
   DpSlamStats stats_{};
   ScanRays rays_{};
   // The processed scans before the last (a ring, oldest at seed_head_ once full): a new
