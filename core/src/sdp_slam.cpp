@@ -213,6 +213,7 @@ bool SdpSlamImpl::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Aren
     return false;
   }
   filter_->set_pose_sink(&ring_sink_);
+  filter_->set_map_room(&room_for_writes_);
   {
     // A segment's updates must stay within a square of half the window (DpMap's wrap
     // contract): its path within window/8 of its start (process()) and its beams'

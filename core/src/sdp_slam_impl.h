@@ -163,7 +163,20 @@ class SdpSlamImpl {
   SegmentGraph graph_;
   Segmenter* segmenter_ = nullptr;
   Rng rng_;
+  // The bottom level's writes of a scan (DpSlamFilter: all in the pool before prune
+  // folds them) get room from older levels, as a new segment does (make_room()): a scan
+  // that first sees an open hall asks several times what any scan before it did, which
+  // no estimate from past scans foresees.
+  class RoomForWrites final : public MapRoom {
+   public:
+    explicit RoomForWrites(SdpSlamImpl& owner) : owner_(owner) {}
+    void make_room(std::uint64_t observations) override { owner_.make_room(observations); }
+
+   private:
+    SdpSlamImpl& owner_;
+  };
   RingSink ring_sink_{*this};
+  RoomForWrites room_for_writes_{*this};
   SdpPathSink* permanent_sink_ = nullptr;
   TopLevelListener* listener_ = nullptr;
   SdpStats stats_{};

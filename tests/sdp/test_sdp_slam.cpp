@@ -710,6 +710,52 @@ TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
   CHECK(for_room > 0U);
 }
 
+// A robot that has seen only what is near (a narrow corridor: beams beyond 2.5 m give
+// nothing) for many segments, and then sees the whole room at once (an open hall): that
+// scan asks the pool for several times what any scan before it did. Whatever the pool's
+// size between 1.25 and 2 times the most one step asks (a restart's included), none of
+// its updates is refused: the bottom level asks for room for its writes before making
+// them, from their bound at the particles' poses, and older levels become permanent for
+// it (without that, 2 of these 7 sizes refuse updates).
+TEST(SdpSlam, no_pool_size_makes_a_scan_that_suddenly_sees_far_refuse_updates) {
+  test::ScanSet set(2);
+  const std::size_t hall = 2U * set.scans.size() / 3U;
+  for (std::size_t i = 0; i < hall; ++i) {
+    RangeScan& scan = *set.scans[i];
+    for (std::uint32_t b = 0; b < scan.beam_count; ++b) {
+      if (scan.ranges_m[b] > 2.5F) scan.ranges_m[b] = 0.0F;  // invalid: traced nothing
+    }
+  }
+  SdpOptions s = test::small_sdp_options();
+  s.max_levels = 16U;  // the corridor's levels fill the pool
+  std::uint64_t most = 0U;
+  {
+    test::SdpRig rig;
+    CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+    const DpMap& m = rig.slam->bottom().map();
+    for (std::size_t i = 0; i < set.scans.size(); ++i) {
+      const std::uint64_t before = m.observations_requested();
+      rig.slam->process(set.odom(i), *set.scans[i]);
+      const std::uint64_t asked = m.observations_requested() - before;
+      if (asked > most) most = asked;
+    }
+    LONGS_EQUAL(0, m.observation_oom_count());
+  }
+  std::uint64_t room_asked = 0U;
+  for (std::uint32_t k = 2U; k <= 8U; ++k) {
+    s.map_observation_capacity = static_cast<std::uint32_t>(most + k * most / 8U);
+    test::SdpRig rig;
+    CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+    test::CollectPoses sink;
+    run_sdp(rig, set, &sink);
+    room_asked += rig.slam->bottom().stats().map_room_asked;
+    LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+    CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+    CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
+  }
+  CHECK(room_asked > 0U);
+}
+
 TEST(SdpSlam, segslam_topology_runs_the_same_pipeline) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
