@@ -233,7 +233,8 @@ class RecordingRoom final : public MapRoom {
 // free room may not hold them, and for no less than they take: a step that does not ask
 // has nothing refused, and a step asks only with less room free than it asks for. What
 // the writes take is measured on a twin run with an ample pool, identical step for step
-// until the tight pool first refuses an update. With the pool ample it never asks.
+// until the tight pool first refuses an update. With the pool ample it never asks. A
+// restart asks too, scan by scan.
 TEST(DpSlamFilter, a_map_room_is_asked_before_writes_the_pool_may_not_hold_and_for_no_less) {
   const test::SimRun run = test::make_loop();
   const auto world = test::room_world();
@@ -281,6 +282,14 @@ TEST(DpSlamFilter, a_map_room_is_asked_before_writes_the_pool_may_not_hold_and_f
   CHECK(map.observation_oom_count() > 0U);  // this room frees nothing
   LONGS_EQUAL(room.asked, rig.filter->stats().map_room_asked);
   LONGS_EQUAL(room.asked, rig.filter->stats().map_room_short);
+  // A restart writes the last scans into the new root one by one, each asking for
+  // itself: at least the newest, at most all of them (the newest and three before it).
+  const std::uint32_t asked_before = room.asked;
+  CHECK_TRUE(rig.filter->restart_segment(rig.filter->best_pose()));
+  CHECK(room.asked > asked_before);
+  CHECK(room.asked <= asked_before + 4U);
+  CHECK_TRUE(rig.filter->tree().invariants_hold());
+  CHECK_TRUE(map.invariants_hold());
 }
 
 TEST(DpSlamFilter, best_path_ends_at_the_best_pose) {

@@ -354,27 +354,20 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
     });
     for (std::uint32_t k = 0; k < seed_count_; ++k) at[k] = start_pose.compose(best_inverse.compose(at[k]));
   }
-  // Room for the root's writes (MapRoom), asked before the root exists: making room
-  // prunes the tree.
-  if (room_ != nullptr) {
-    std::uint64_t quick = beam_.cells_bound(rays_);
-    for (std::uint32_t k = 0; k < seed_count_; ++k) quick += found[k] ? beam_.cells_bound(seed_rays_[k]) : 0U;
-    if (quick > free_observations()) {
-      std::uint64_t need = beam_.cells_bound_at(map_, rays_, start_pose);
-      for (std::uint32_t k = 0; k < seed_count_; ++k) {
-        need += found[k] ? beam_.cells_bound_at(map_, seed_rays_[k], at[k]) : 0U;
-      }
-      ask_room(need);
-    }
-  }
   const NodeId root = tree_.create_root();
   if (root == kNoNode) {
     ++restart_refused_count_;
     return false;
   }
+  // Each scan asks room for itself (MapRoom) before it is written: the root keeps every
+  // write (one node: the scans' common cells are shared), so what one scan adds is bounded
+  // by its own cells. The root is an active leaf, which making room leaves alone.
   for (std::uint32_t k = 0; k < seed_count_; ++k) {
-    if (found[k]) stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k]);
+    if (!found[k]) continue;
+    ask_room_for_scan(seed_rays_[k], at[k]);
+    stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k]);
   }
+  ask_room_for_scan(rays_, start_pose);
   stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose);
   seed_count_ = 0U;  // the next segment starts from its own scans
   seed_head_ = 0U;
@@ -417,6 +410,11 @@ void DpSlamFilter::ask_room_for_writes() {
     if (writes(i)) need += beam_.cells_bound_at(map_, rays_, proposed_[i]);
   }
   ask_room(need);
+}
+
+void DpSlamFilter::ask_room_for_scan(const ScanRays& rays, const Pose2& pose) {
+  if (room_ == nullptr || beam_.cells_bound(rays) <= free_observations()) return;
+  ask_room(beam_.cells_bound_at(map_, rays, pose));
 }
 
 std::uint64_t DpSlamFilter::free_observations() const {

@@ -194,6 +194,8 @@ class DpSlamFilter {
   // Before step 4: the writers' scans at their proposed poses, bounded, and room asked
   // for them where the pool's free room may not hold them.
   void ask_room_for_writes();
+  // ... for one scan written at `pose` into one node (a restart's root).
+  void ask_room_for_scan(const ScanRays& rays, const Pose2& pose);
   // Asks room_ for `need` observations beyond those in use where fewer are free.
   void ask_room(std::uint64_t need);
   std::uint64_t free_observations() const;
