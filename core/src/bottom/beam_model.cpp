@@ -16,8 +16,9 @@ std::int32_t floor_cell(double v) {
   return static_cast<std::int32_t>(i);
 }
 
-// Integer Bresenham from (x0, y0) to (x1, y1) inclusive, one cell at a time: every step
-// moves one cell along the longer axis (and at most one along the other).
+// Integer Bresenham from (x0, y0) to (x1, y1) inclusive, one cell at a time, stepping
+// exactly as trace_cells() below: every step moves one cell along the longer axis (and
+// at most one along the other).
 struct Bresenham {
   std::int64_t dx, dy, err;
   std::int32_t sx, sy, x, y, x1, y1;
@@ -32,8 +33,7 @@ struct Bresenham {
         x1(to_x),
         y1(to_y) {}
   bool last() const { return x == x1 && y == y1; }
-  // A beam is at most a few thousand cells long; the bound guards against garbage input.
-  std::int64_t steps_bound() const { return dx + dy + 1; }
+  std::int64_t steps_bound() const { return dx + dy + 1; }  // as trace_cells()' guard
   void step() {
     const std::int64_t e2 = 2 * err;
     if (e2 > -dy) {
@@ -47,14 +47,30 @@ struct Bresenham {
   }
 };
 
-// f(ix, iy, last) for every cell from (x0, y0) to (x1, y1); f returns false to stop early.
+// f(ix, iy, last) for every cell from (x0, y0) to (x1, y1), as Bresenham steps (written
+// out: this is the observation model's inner loop); f returns false to stop early.
 template <class F>
 void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1, F&& f) {
-  Bresenham line(x0, y0, x1, y1);
-  for (std::int64_t guard = 0; guard <= line.steps_bound(); ++guard) {
-    const bool last = line.last();
-    if (!f(line.x, line.y, last) || last) return;
-    line.step();
+  const std::int64_t dx = x1 >= x0 ? static_cast<std::int64_t>(x1) - x0 : static_cast<std::int64_t>(x0) - x1;
+  const std::int64_t dy = y1 >= y0 ? static_cast<std::int64_t>(y1) - y0 : static_cast<std::int64_t>(y0) - y1;
+  const std::int32_t sx = x0 < x1 ? 1 : -1;
+  const std::int32_t sy = y0 < y1 ? 1 : -1;
+  std::int64_t err = dx - dy;
+  std::int32_t x = x0;
+  std::int32_t y = y0;
+  // A beam is at most a few thousand cells long; the bound guards against garbage input.
+  for (std::int64_t guard = 0; guard <= dx + dy + 1; ++guard) {
+    const bool last = (x == x1 && y == y1);
+    if (!f(x, y, last) || last) return;
+    const std::int64_t e2 = 2 * err;
+    if (e2 > -dy) {
+      err -= dy;
+      x += sx;
+    }
+    if (e2 < dx) {
+      err += dx;
+      y += sy;
+    }
   }
 }
 
