@@ -111,19 +111,26 @@ TEST(BeamModel, beams_leaving_the_map_are_counted_as_dropped_not_fatal) {
   CHECK_TRUE(f.map.invariants_hold());
 }
 
-// cells_bound() and cells_bound_at() are upper bounds on the new observations
-// update_map() takes, the first at any pose and heading (it does not know the pose),
-// and close enough to be of use: the first within twice what a dense fan of beams
-// writes; the second within 5 % of what the room's scan writes, and within 1.6 times on
-// fans whose ranges jump from beam to beam (a short beam between two long ones hides
-// the cells they share).
-TEST(BeamModel, the_cells_bounds_hold_at_every_pose_and_are_tight) {
+// cells_bound() is an upper bound on the new observations update_map() takes at any pose
+// and heading (it does not know the pose), within twice what a dense fan of beams
+// writes; cells_written() is what update_map() takes, exactly, into a fresh node or one
+// that holds some of the cells already. Both hold for a write with a shortened update
+// range too.
+TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
   std::uint32_t state = 12345U;
   const auto uniform = [&state](double lo, double hi) {
     state = state * 1664525U + 1013904223U;
     return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
   };
   const auto world = test::room_world();
+  const BeamModelOptions defaults;
+  std::vector<std::uint64_t> marks(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
+  const auto all_zero = [&marks] {
+    for (const std::uint64_t w : marks) {
+      if (w != 0U) return false;
+    }
+    return true;
+  };
   for (std::uint32_t trial = 0; trial < 40U; ++trial) {
     MapFixture f;
     const Pose2 pose{uniform(1.0, 9.0), uniform(1.0, 4.0), uniform(-3.14, 3.14)};
@@ -140,20 +147,36 @@ TEST(BeamModel, the_cells_bounds_hold_at_every_pose_and_are_tight) {
       for (std::uint32_t b = 0; b < f.scan->beam_count; ++b) f.scan->ranges_m[b] = static_cast<float>(uniform(0.2, 6.0));
     }
     prepare_rays(*f.scan, f.rays.get());
+    const std::uint64_t counted =
+        f.beam.cells_written(f.map, *f.rays, pose, defaults.max_update_range_m, kNoNode, marks.data());
+    CHECK_TRUE(all_zero());
     const std::uint32_t before = f.map.observations_used();
     LONGS_EQUAL(0, f.beam.update_map(f.map, f.root, *f.rays, pose));
     const std::uint64_t written = f.map.observations_used() - before;
     const std::uint64_t bound = f.beam.cells_bound(*f.rays);
-    const std::uint64_t at = f.beam.cells_bound_at(f.map, *f.rays, pose);
     CHECK(written > 0U);
+    LONGS_EQUAL(written, counted);
     CHECK(bound >= written);
-    CHECK(at >= written);
-    if (trial % 2U == 1U) {
-      CHECK(bound <= 2U * written);
-      CHECK(5U * at <= 8U * written);
-    } else if (written > 1000U) {
-      CHECK(20U * at <= 21U * written);  // ranges vary smoothly along a real scan
-    }
+    if (trial % 2U == 1U) CHECK(bound <= 2U * written);
+    // A write with a shortened update range.
+    MapFixture g;
+    const double reach_m = uniform(0.0, 4.0);
+    const std::uint64_t counted_short = g.beam.cells_written(g.map, *f.rays, pose, reach_m, kNoNode, marks.data());
+    LONGS_EQUAL(0, g.beam.update_map(g.map, g.root, *f.rays, pose, reach_m));
+    const std::uint64_t shortened = g.map.observations_used();
+    CHECK(shortened > 0U);
+    CHECK(shortened <= written);
+    LONGS_EQUAL(shortened, counted_short);
+    CHECK(g.beam.cells_bound(*f.rays, reach_m) >= shortened);
+    CHECK(g.beam.cells_bound(*f.rays, reach_m) <= bound);
+    // Into a node that holds cells already (a restart's root takes several scans): what
+    // the full write then adds, exactly.
+    const std::uint64_t counted_more =
+        g.beam.cells_written(g.map, *f.rays, pose, defaults.max_update_range_m, g.root, marks.data());
+    CHECK_TRUE(all_zero());
+    LONGS_EQUAL(0, g.beam.update_map(g.map, g.root, *f.rays, pose));
+    LONGS_EQUAL(g.map.observations_used() - shortened, counted_more);
+    LONGS_EQUAL(0, g.beam.cells_written(g.map, *f.rays, pose, defaults.max_update_range_m, g.root, marks.data()));
   }
 }
 

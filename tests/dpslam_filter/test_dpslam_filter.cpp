@@ -231,10 +231,12 @@ class RecordingRoom final : public MapRoom {
 
 // Before its map writes the filter asks its MapRoom for room exactly where the pool's
 // free room may not hold them, and for no less than they take: a step that does not ask
-// has nothing refused, and a step asks only with less room free than it asks for. What
-// the writes take is measured on a twin run with an ample pool, identical step for step
-// until the tight pool first refuses an update. With the pool ample it never asks. A
-// restart asks too, scan by scan.
+// has nothing refused or shortened, and a step asks only with less room free than it asks
+// for. What the writes take is measured on a twin run with an ample pool, identical step
+// for step until the tight pool first shortens a write. With the pool ample it never
+// asks. Where the room stays short (this one frees nothing), the step writes with a
+// shortened update range, and what it writes fits: nothing is refused. A restart asks
+// too, scan by scan.
 TEST(DpSlamFilter, a_map_room_is_asked_before_writes_the_pool_may_not_hold_and_for_no_less) {
   const test::SimRun run = test::make_loop();
   const auto world = test::room_world();
@@ -257,37 +259,48 @@ TEST(DpSlamFilter, a_map_room_is_asked_before_writes_the_pool_may_not_hold_and_f
     }
     LONGS_EQUAL(0, room.asked);
     LONGS_EQUAL(0, rig.filter->map().observation_oom_count());
+    LONGS_EQUAL(0, rig.filter->stats().map_writes_shortened);
   }
   FilterRig rig;
   CHECK_TRUE(rig.init(options(40000U), 5));
   const DpMap& map = rig.filter->map();
+  const DpSlamStats& stats = rig.filter->stats();
   RecordingRoom room(map);
   rig.filter->set_map_room(&room);
   std::uint32_t compared = 0U;
   for (std::size_t i = 0; i < run.truth.size(); ++i) {
     const std::uint32_t asked_before = room.asked;
-    const std::uint64_t refused_before = map.observation_oom_count();
+    const std::uint64_t shortened_before = stats.map_writes_shortened;
+    const std::uint64_t free_before = map.observation_capacity() - map.observations_used();
+    const std::uint64_t requested_before = map.observations_requested();
     rig.step(run, world, i);
+    CHECK(map.observations_requested() - requested_before <= free_before);  // the writes fit
     if (room.asked == asked_before) {
-      LONGS_EQUAL(refused_before, map.observation_oom_count());
+      LONGS_EQUAL(shortened_before, stats.map_writes_shortened);
     } else {
       CHECK(room.free_then < room.need);
-      if (refused_before == 0U) {
+      LONGS_EQUAL(shortened_before + 1U, stats.map_writes_shortened);  // this room frees nothing
+      if (shortened_before == 0U) {
         CHECK(takes[i] <= room.need);
         ++compared;
       }
     }
   }
   CHECK(compared > 0U);
-  CHECK(map.observation_oom_count() > 0U);  // this room frees nothing
-  LONGS_EQUAL(room.asked, rig.filter->stats().map_room_asked);
-  LONGS_EQUAL(room.asked, rig.filter->stats().map_room_short);
+  LONGS_EQUAL(0, map.observation_oom_count());
+  LONGS_EQUAL(0, stats.map_updates_dropped);
+  LONGS_EQUAL(room.asked, stats.map_room_asked);
+  LONGS_EQUAL(room.asked, stats.map_room_short);
+  LONGS_EQUAL(room.asked, stats.map_writes_shortened);
+  CHECK(stats.shortest_write_reach_m < rig.filter->options().beam.max_update_range_m);
   // A restart writes the last scans into the new root one by one, each asking for
   // itself: at least the newest, at most all of them (the newest and three before it).
   const std::uint32_t asked_before = room.asked;
   CHECK_TRUE(rig.filter->restart_segment(rig.filter->best_pose()));
   CHECK(room.asked > asked_before);
   CHECK(room.asked <= asked_before + 4U);
+  LONGS_EQUAL(room.asked, stats.map_writes_shortened);
+  LONGS_EQUAL(0, map.observation_oom_count());
   CHECK_TRUE(rig.filter->tree().invariants_hold());
   CHECK_TRUE(map.invariants_hold());
 }

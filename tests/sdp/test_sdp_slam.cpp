@@ -689,9 +689,10 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
 }
 
 // Whatever the pool's size between half of and all that the run's live levels hold at
-// their peak, no map update is refused: a segment starts only with room for its restart
-// (its first scan written whole into every fresh lineage) and the scan after it, before
-// which its own pool check cannot end it.
+// their peak, every scan is written whole (no map update is refused, no write shortened):
+// a segment starts only with room for its restart (its first scan written whole into
+// every fresh lineage) and the scan after it, before which its own pool check cannot end
+// it.
 TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
   const test::ScanSet set(2);
   SdpOptions s = test::small_sdp_options();
@@ -705,6 +706,7 @@ TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
     run_sdp(rig, set, &sink);
     for_room += rig.slam->stats().levels_made_permanent_for_room;
     LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+    LONGS_EQUAL(0, rig.slam->bottom().stats().map_writes_shortened);
     CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
   }
   CHECK(for_room > 0U);
@@ -713,10 +715,11 @@ TEST(SdpSlam, no_pool_size_makes_a_new_segment_refuse_its_first_scans) {
 // A robot that has seen only what is near (a narrow corridor: beams beyond 2.5 m give
 // nothing) for many segments, and then sees the whole room at once (an open hall): that
 // scan asks the pool for several times what any scan before it did. Whatever the pool's
-// size between 1.25 and 2 times the most one step asks (a restart's included), none of
-// its updates is refused: the bottom level asks for room for its writes before making
-// them, from their bound at the particles' poses, and older levels become permanent for
-// it (without that, 2 of these 7 sizes refuse updates).
+// size between 1.25 and 2 times the most one step asks (a restart's included), every
+// scan is written whole (no update refused, no write shortened): the bottom level asks
+// for room for its writes before making them, from their count at the particles' poses,
+// and older levels become permanent for it (without that, 2 of these 7 sizes have
+// writes shortened).
 TEST(SdpSlam, no_pool_size_makes_a_scan_that_suddenly_sees_far_refuse_updates) {
   test::ScanSet set(2);
   const std::size_t hall = 2U * set.scans.size() / 3U;
@@ -750,6 +753,7 @@ TEST(SdpSlam, no_pool_size_makes_a_scan_that_suddenly_sees_far_refuse_updates) {
     run_sdp(rig, set, &sink);
     room_asked += rig.slam->bottom().stats().map_room_asked;
     LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+    LONGS_EQUAL(0, rig.slam->bottom().stats().map_writes_shortened);
     CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
     CHECK_TRUE(rig.slam->bottom().tree().invariants_hold());
   }

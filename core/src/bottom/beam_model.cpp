@@ -16,39 +16,8 @@ std::int32_t floor_cell(double v) {
   return static_cast<std::int32_t>(i);
 }
 
-// Integer Bresenham from (x0, y0) to (x1, y1) inclusive, one cell at a time, stepping
-// exactly as trace_cells() below: every step moves one cell along the longer axis (and
-// at most one along the other).
-struct Bresenham {
-  std::int64_t dx, dy, err;
-  std::int32_t sx, sy, x, y, x1, y1;
-  Bresenham(std::int32_t x0, std::int32_t y0, std::int32_t to_x, std::int32_t to_y)
-      : dx(to_x >= x0 ? static_cast<std::int64_t>(to_x) - x0 : static_cast<std::int64_t>(x0) - to_x),
-        dy(to_y >= y0 ? static_cast<std::int64_t>(to_y) - y0 : static_cast<std::int64_t>(y0) - to_y),
-        err(dx - dy),
-        sx(x0 < to_x ? 1 : -1),
-        sy(y0 < to_y ? 1 : -1),
-        x(x0),
-        y(y0),
-        x1(to_x),
-        y1(to_y) {}
-  bool last() const { return x == x1 && y == y1; }
-  std::int64_t steps_bound() const { return dx + dy + 1; }  // as trace_cells()' guard
-  void step() {
-    const std::int64_t e2 = 2 * err;
-    if (e2 > -dy) {
-      err -= dy;
-      x += sx;
-    }
-    if (e2 < dx) {
-      err += dx;
-      y += sy;
-    }
-  }
-};
-
-// f(ix, iy, last) for every cell from (x0, y0) to (x1, y1), as Bresenham steps (written
-// out: this is the observation model's inner loop); f returns false to stop early.
+// f(ix, iy, last) for every cell from (x0, y0) to (x1, y1), as Bresenham steps; f returns
+// false to stop early.
 template <class F>
 void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1, F&& f) {
   const std::int64_t dx = x1 >= x0 ? static_cast<std::int64_t>(x1) - x0 : static_cast<std::int64_t>(x0) - x1;
@@ -72,22 +41,6 @@ void trace_cells(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t
       y += sy;
     }
   }
-}
-
-// Cells two lines from one start cell share step for step (the same cell at the same step).
-std::uint64_t shared_cells(std::int32_t x0, std::int32_t y0, std::int32_t ax, std::int32_t ay, std::int32_t bx,
-                           std::int32_t by) {
-  Bresenham a(x0, y0, ax, ay);
-  Bresenham b(x0, y0, bx, by);
-  std::uint64_t shared = 0U;
-  const std::int64_t guard_end = a.steps_bound() < b.steps_bound() ? a.steps_bound() : b.steps_bound();
-  for (std::int64_t guard = 0; guard <= guard_end; ++guard) {
-    if (a.x == b.x && a.y == b.y) ++shared;
-    if (a.last() || b.last()) break;
-    a.step();
-    b.step();
-  }
-  return shared;
 }
 
 inline double mantissa_and_exponent(double v, std::int64_t* exponent) {
@@ -256,19 +209,22 @@ double BeamModel::likelihood(const DpMap& map, const ScanRays& rays, const Pose2
 struct BeamModel::Tracer {
   LaserFrame lf;
   double inv_res, ox, oy;
+  double reach_m;
   std::int32_t lx, ly;
-  Tracer(const BeamModel& m, const DpMap& map, const ScanRays& rays, const Pose2& robot)
+  Tracer(const BeamModel& m, const DpMap& map, const ScanRays& rays, const Pose2& robot, double reach)
       : lf(laser_frame(rays, robot)),
         inv_res(1.0 / m.resolution_m_),
         ox(map.options().origin_x_m),
         oy(map.options().origin_y_m),
+        reach_m(reach < 0.0 ? 0.0 : (reach < m.options_.max_update_range_m ? reach : m.options_.max_update_range_m)),
         lx(floor_cell((lf.x_m - ox) * inv_res)),
         ly(floor_cell((lf.y_m - oy) * inv_res)) {}
   // Beam b's end cell and whether it is a hit; false iff the beam traces nothing.
   bool end_cell(const BeamModel& m, const ScanRays& rays, std::uint32_t b, std::int32_t* ex, std::int32_t* ey,
                 bool* hit) const {
     double end_m;
-    if (!m.traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), &end_m, hit)) {
+    if (!m.traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), reach_m, &end_m,
+                    hit)) {
       return false;
     }
     const double dx = lf.c * rays.cos_a[b] - lf.s * rays.sin_a[b];
@@ -279,8 +235,9 @@ struct BeamModel::Tracer {
   }
 };
 
-std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
-  const Tracer t(*this, map, rays, robot);
+std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
+                                    double reach_m) const {
+  const Tracer t(*this, map, rays, robot, reach_m);
   std::uint32_t dropped = 0U;
   for (std::uint32_t b = 0; b < rays.count; ++b) {
     std::int32_t ex;
@@ -296,44 +253,69 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
   return dropped;
 }
 
-std::uint64_t BeamModel::cells_bound_at(const DpMap& map, const ScanRays& rays, const Pose2& robot) const {
-  const Tracer t(*this, map, rays, robot);
+namespace {
+// Cells from the laser's cell to the far edge of the square marks cover: a traced end
+// cell lies within floor(end / cell) + 1 of it (floor_cell of both ends), +1 for
+// floating-point rounding.
+std::int32_t marks_half(double max_update_range_m, double resolution_m) {
+  return static_cast<std::int32_t>(max_update_range_m / resolution_m) + 2;
+}
+}  // namespace
+
+std::size_t BeamModel::marks_words(double max_update_range_m, double resolution_m) {
+  if (!(max_update_range_m >= 0.0) || !(resolution_m > 0.0) || !(max_update_range_m / resolution_m < 1.0e5)) {
+    return 0U;
+  }
+  const auto side = static_cast<std::size_t>(2 * marks_half(max_update_range_m, resolution_m) + 1);
+  return (side * side + 63U) / 64U;
+}
+
+std::uint64_t BeamModel::cells_written(const DpMap& map, const ScanRays& rays, const Pose2& robot, double reach_m,
+                                       NodeId into, std::uint64_t* marks) const {
+  const Tracer t(*this, map, rays, robot, reach_m);
+  const std::int32_t half = marks_half(options_.max_update_range_m, resolution_m_);
+  const std::int64_t side = 2 * static_cast<std::int64_t>(half) + 1;
   std::uint64_t cells = 0U;
-  bool previous = false;
-  std::int32_t px = 0;
-  std::int32_t py = 0;
   for (std::uint32_t b = 0; b < rays.count; ++b) {
     std::int32_t ex;
     std::int32_t ey;
     bool hit;
     if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
-    const std::int64_t ax = ex >= t.lx ? static_cast<std::int64_t>(ex) - t.lx : static_cast<std::int64_t>(t.lx) - ex;
-    const std::int64_t ay = ey >= t.ly ? static_cast<std::int64_t>(ey) - t.ly : static_cast<std::int64_t>(t.ly) - ey;
-    cells += static_cast<std::uint64_t>(ax > ay ? ax : ay) + 1U;
-    if (previous) cells -= shared_cells(t.lx, t.ly, px, py, ex, ey);
-    px = ex;
-    py = ey;
-    previous = true;
+    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool) {
+      const std::int64_t mx = static_cast<std::int64_t>(ix) - t.lx + half;
+      const std::int64_t my = static_cast<std::int64_t>(iy) - t.ly + half;
+      if (mx < 0 || my < 0 || mx >= side || my >= side) {
+        ++cells;  // cannot happen (the square holds every traced cell); counted anyway
+        return true;
+      }
+      const auto bit = static_cast<std::uint64_t>(my * side + mx);
+      const std::uint64_t mask = std::uint64_t{1} << (bit & 63U);
+      if ((marks[bit >> 6U] & mask) == 0U) {
+        marks[bit >> 6U] |= mask;
+        if (into == kNoNode || !map.owns(into, ix, iy)) ++cells;
+      }
+      return true;
+    });
   }
+  std::memset(marks, 0, marks_words(options_.max_update_range_m, resolution_m_) * sizeof(std::uint64_t));
   return cells;
 }
 
-bool BeamModel::traced_m(RangeScan::Beam kind, double range_m, double* end_m, bool* hit) const {
+bool BeamModel::traced_m(RangeScan::Beam kind, double range_m, double reach_m, double* end_m, bool* hit) const {
   if (kind == RangeScan::Beam::kReturn) {
-    *hit = range_m <= options_.max_update_range_m;
-    *end_m = *hit ? range_m : options_.max_update_range_m;
+    *hit = range_m <= reach_m;
+    *end_m = *hit ? range_m : reach_m;
     return true;
   }
   if (kind == RangeScan::Beam::kNoReturn && options_.no_return_free_m > 0.0) {
     *hit = false;
-    *end_m = options_.no_return_free_m < options_.max_update_range_m ? options_.no_return_free_m
-                                                                       : options_.max_update_range_m;
+    *end_m = options_.no_return_free_m < reach_m ? options_.no_return_free_m : reach_m;
     return true;
   }
   return false;
 }
 
-std::uint64_t BeamModel::cells_bound(const ScanRays& rays) const {
+std::uint64_t BeamModel::cells_bound(const ScanRays& rays, double reach_m) const {
   // Past k = beams / 8 the square grows faster than the beams' tails shrink ((2k + 1)^2
   // grows by 8k + 8, the tails by at most the number of beams), so the least is below.
   constexpr std::uint32_t kMaxK = capacity::kMaxBeams / 8U + 1U;
@@ -343,7 +325,8 @@ std::uint64_t BeamModel::cells_bound(const ScanRays& rays) const {
   for (std::uint32_t b = 0; b < rays.count; ++b) {
     double end_m;
     bool hit;
-    if (!traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), &end_m, &hit)) {
+    if (!traced_m(static_cast<RangeScan::Beam>(rays.kind[b]), static_cast<double>(rays.range_m[b]), reach_m, &end_m,
+                  &hit)) {
       continue;
     }
     const auto cells = static_cast<std::uint64_t>(end_m / resolution_m_) + 3U;

@@ -594,6 +594,14 @@ std::uint32_t DpMap::observation_count(NodeId node) const {
   return owner == kNone ? 0U : owner_count_[owner];
 }
 
+bool DpMap::owns(NodeId node, std::int32_t ix, std::int32_t iy) const {
+  if (tree_ == nullptr || !tree_->contains(node) || !in_bounds(ix, iy)) return false;
+  const std::uint32_t slot = tile_table_[tile_index(ix, iy)];
+  if (slot == kNone) return false;
+  const std::uint32_t e = find_view(node, slot, cell_in_tile(ix, iy));
+  return e != kNone && owner_node_[obs_[e].owner] == node;
+}
+
 std::size_t DpMap::footprint_bytes() const {
   return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + kOwnerTables * node_capacity_ +
                                   static_cast<std::size_t>(index_mask_) + 1U) +

@@ -73,7 +73,9 @@ std::size_t DpSlamFilter::required_arena_bytes(const DpSlamOptions& o) {
   const std::uint32_t n = o.particle_count;
   return AncestryTree::required_arena_bytes(o.node_capacity(), o.path_entry_capacity()) + map_bytes +
          2U * array_bytes<Particle>(n) + array_bytes<Pose2>(n) + 2U * array_bytes<double>(n) +
-         2U * array_bytes<std::uint32_t>(n) + kSlack +
+         2U * array_bytes<std::uint32_t>(n) +
+         Arena::bytes_for<std::uint64_t>(BeamModel::marks_words(o.beam.max_update_range_m, o.map_resolution_m)) +
+         kSlack +
          (o.proposal == DpSlamOptions::Proposal::kScanMatch ? ViewCache::required_arena_bytes(capacity::kViewCacheSlots)
                                                             : 0U);
 }
@@ -113,8 +115,10 @@ bool DpSlamFilter::init(const DpSlamOptions& options, Arena& arena, std::uint64_
   w_ = arena.allocate_array<double>(n);
   drawn_ = arena.allocate_array<std::uint32_t>(n);
   counts_ = arena.allocate_array<std::uint32_t>(n);
+  marks_ = arena.allocate_array<std::uint64_t>(BeamModel::marks_words(options.beam.max_update_range_m,
+                                                                      options.map_resolution_m));
   if (particles_ == nullptr || next_ == nullptr || proposed_ == nullptr || log_w_ == nullptr || w_ == nullptr ||
-      drawn_ == nullptr || counts_ == nullptr) {
+      drawn_ == nullptr || counts_ == nullptr || marks_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving particle arrays");
     return false;
   }
@@ -219,11 +223,11 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   for (std::uint32_t m = 0; m < n; ++m) ++counts_[drawn_[m]];
   // 4. map update and path of every surviving particle (once per node: duplicates
   //    become children that inherit it).
-  if (room_ != nullptr) ask_room_for_writes();
+  const double reach_m = reach_that_fits(rays_, nullptr, kNoNode);
   std::uint32_t dropped = 0U;
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!writes(i)) continue;
-    dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i]);
+    dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i], reach_m);
     tree_.append_pose(particles_[i].node, scan.stamp_us, proposed_[i]);
   }
   const double best_lw = log_w_[best];
@@ -364,11 +368,11 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
   // by its own cells. The root is an active leaf, which making room leaves alone.
   for (std::uint32_t k = 0; k < seed_count_; ++k) {
     if (!found[k]) continue;
-    ask_room_for_scan(seed_rays_[k], at[k]);
-    stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k]);
+    const double reach_m = reach_that_fits(seed_rays_[k], &at[k], root);
+    stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k], reach_m);
   }
-  ask_room_for_scan(rays_, start_pose);
-  stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose);
+  const double reach_m = reach_that_fits(rays_, &start_pose, root);
+  stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose, reach_m);
   seed_count_ = 0U;  // the next segment starts from its own scans
   seed_head_ = 0U;
   for (std::uint32_t i = 0; i < particle_count_; ++i) {
@@ -398,34 +402,59 @@ bool DpSlamFilter::writes(std::uint32_t i) const {
 }
 
 // The writers are the surviving particles, one per node (step 4). Every writer's node is
-// a fresh leaf (or, degraded, its parent's node), so it takes at most one new
-// observation per cell its scan traces. The bound at any pose is checked first (O(beams));
-// only where the pool is that tight are the writers' scans traced at their poses.
-void DpSlamFilter::ask_room_for_writes() {
-  std::uint32_t writers = 0U;
-  for (std::uint32_t i = 0; i < particle_count_; ++i) writers += writes(i) ? 1U : 0U;
-  if (std::uint64_t{writers} * beam_.cells_bound(rays_) <= free_observations()) return;
+// a fresh leaf (or, degraded, its parent's node), so it takes one new observation per
+// distinct cell its scan traces (at most, for the parent's node).
+std::uint64_t DpSlamFilter::writes_bound(const ScanRays& rays, const Pose2* pose, NodeId into, double reach_m) const {
+  if (pose != nullptr) return beam_.cells_written(map_, rays, *pose, reach_m, into, marks_);
   std::uint64_t need = 0U;
   for (std::uint32_t i = 0; i < particle_count_; ++i) {
-    if (writes(i)) need += beam_.cells_bound_at(map_, rays_, proposed_[i]);
+    if (writes(i)) need += beam_.cells_written(map_, rays, proposed_[i], reach_m, kNoNode, marks_);
   }
-  ask_room(need);
+  return need;
 }
 
-void DpSlamFilter::ask_room_for_scan(const ScanRays& rays, const Pose2& pose) {
-  if (room_ == nullptr || beam_.cells_bound(rays) <= free_observations()) return;
-  ask_room(beam_.cells_bound_at(map_, rays, pose));
+// The bound at any pose is checked first (O(beams)); only where the pool is that tight
+// are the scans' cells counted at their poses. Where the writes do not fit, the MapRoom
+// is asked for room; where it cannot make enough, the update range is bisected down to a
+// range whose writes fit, within max_update_range_m / 2^kReachBisections of the longest
+// (the writes grow with the range; a range is kept only once its count fits, so the
+// writes made always fit). The near cells, which the next scans are
+// weighed against first, are then written in full, and every writer loses the same far
+// misses, instead of the last writers losing whole scans to refusals. Where even a zero
+// range does not fit, the pool refuses what it cannot hold (map_updates_dropped).
+double DpSlamFilter::reach_that_fits(const ScanRays& rays, const Pose2* pose, NodeId into) {
+  const double full_m = beam_.options().max_update_range_m;
+  std::uint64_t nodes = 1U;
+  if (pose == nullptr) {
+    nodes = 0U;
+    for (std::uint32_t i = 0; i < particle_count_; ++i) nodes += writes(i) ? 1U : 0U;
+  }
+  if (nodes * beam_.cells_bound(rays, full_m) <= free_observations()) return full_m;
+  const std::uint64_t need = writes_bound(rays, pose, into, full_m);
+  if (need <= free_observations()) return full_m;
+  if (room_ != nullptr) {
+    ++stats_.map_room_asked;
+    room_->make_room(need);
+    if (need <= free_observations()) return full_m;
+    ++stats_.map_room_short;
+  }
+  double lo_m = 0.0;
+  double hi_m = full_m;
+  for (std::uint32_t k = 0; k < kReachBisections; ++k) {
+    const double mid_m = 0.5 * (lo_m + hi_m);
+    if (writes_bound(rays, pose, into, mid_m) <= free_observations()) {
+      lo_m = mid_m;
+    } else {
+      hi_m = mid_m;
+    }
+  }
+  if (stats_.map_writes_shortened == 0U || lo_m < stats_.shortest_write_reach_m) stats_.shortest_write_reach_m = lo_m;
+  ++stats_.map_writes_shortened;
+  return lo_m;
 }
 
 std::uint64_t DpSlamFilter::free_observations() const {
   return std::uint64_t{map_.observation_capacity()} - map_.observations_used();
-}
-
-void DpSlamFilter::ask_room(std::uint64_t need) {
-  if (room_ == nullptr || need <= free_observations()) return;
-  ++stats_.map_room_asked;
-  room_->make_room(need);
-  if (free_observations() < need) ++stats_.map_room_short;
 }
 
 bool DpSlamFilter::release_anchored(NodeId node) {

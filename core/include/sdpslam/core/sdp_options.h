@@ -83,9 +83,9 @@ struct SdpOptions {
   // submaps go to the permanent map below). The state's 64 MiB budget is what sizes
   // them: tiles with room to spare for an office floor's live submaps, observations the
   // rest. Where the pool runs short, older levels become permanent early, before a
-  // segment starts and before any scan's writes (bounded at the particles' poses); only
-  // a segment that alone outgrows the pool has updates refused, each one counted
-  // (stats.json pools.observations).
+  // segment starts and before any scan's writes (counted at the particles' poses); only
+  // a segment that alone outgrows the pool has a scan's writes made with a shortened
+  // update range, each one counted (stats.json pools.observations.writes_shortened).
   std::uint32_t map_tile_capacity = 2500U;
   std::uint32_t map_observation_capacity = 1505000U;
   // [sdp] tiles of the global map's permanent part (permanent_map.h), 16 × 16 cells of

@@ -183,7 +183,11 @@ io::Json filter_pools_json(const DpSlamFilter& filter) {
                         {"peak", map.observations_peak()},
                         {"exhausted", map.observation_oom_count()},
                         {"room_asked", filter.stats().map_room_asked},
-                        {"room_short", filter.stats().map_room_short}};
+                        {"room_short", filter.stats().map_room_short},
+                        {"writes_shortened", filter.stats().map_writes_shortened},
+                        {"shortest_write_reach_m", filter.stats().map_writes_shortened > 0U
+                                                       ? filter.stats().shortest_write_reach_m
+                                                       : filter.options().beam.max_update_range_m}};
   js["tiles"] = {{"capacity", map.tile_capacity()}, {"peak", map.tiles_peak()}, {"exhausted", map.tile_oom_count()}};
   return js;
 }

@@ -93,22 +93,37 @@ class BeamModel {
 
   // Writes the scan into `particle`'s map. Returns the number of cell updates the map
   // dropped (0 normally).
-  std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const;
-  // Upper bounds on the distinct cells update_map() writes, so on the new observations
-  // one particle's update takes from the pool (its node is fresh). Bresenham moves one
-  // cell along the longer axis per step, so a beam's d-th cell lies on the square ring
-  // d cells around the laser's cell, and a beam traced to `end` has at most
-  // floor(end / cell) + 3 cells (+1 for each end's rounding to a cell, +1 for
-  // floating-point rounding).
-  // - At any pose: the first k + 1 cells of every beam lie within the (2k + 1)^2 square,
-  //   so the scan covers at most (2k + 1)^2 + sum over beams of max(0, cells - k - 1),
-  //   taken at the k that makes it least. O(beams).
-  std::uint64_t cells_bound(const ScanRays& rays) const;
-  // - At `robot`, exactly as update_map() traces: every beam's cells, less the cells it
-  //   shares, step for step, with the next traced beam (beams in scan order sharing a cell
-  //   on a ring are one cell, and a cell shared by a chain of them is counted once per
-  //   chain). The lines are traced twice, without touching the map: O(cells).
-  std::uint64_t cells_bound_at(const DpMap& map, const ScanRays& rays, const Pose2& robot) const;
+  std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot) const {
+    return update_map(map, particle, rays, robot, options_.max_update_range_m);
+  }
+  // The same with the update range shortened to `reach_m` (taken within 0 and
+  // max_update_range_m): beams beyond it mark misses up to it and no hit, as beyond
+  // max_update_range_m. A filter whose pool cannot hold a scan's full writes writes its
+  // near part this way.
+  std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
+                           double reach_m) const;
+  // The new observations one particle's update takes from the pool (its node is fresh)
+  // are the distinct cells update_map() writes.
+  // - An upper bound at any pose: Bresenham moves one cell along the longer axis per
+  //   step, so a beam's d-th cell lies on the square ring d cells around the laser's
+  //   cell, and a beam traced to `end` has at most floor(end / cell) + 3 cells (+1 for
+  //   each end's rounding to a cell, +1 for floating-point rounding). The first k + 1
+  //   cells of every beam lie within the (2k + 1)^2 square, so the scan covers at most
+  //   (2k + 1)^2 + sum over beams of max(0, cells - k - 1), taken at the k that makes it
+  //   least. O(beams).
+  std::uint64_t cells_bound(const ScanRays& rays) const { return cells_bound(rays, options_.max_update_range_m); }
+  std::uint64_t cells_bound(const ScanRays& rays, double reach_m) const;
+  // - The count at `robot`, traced exactly as update_map() with update range `reach_m`
+  //   traces, without touching the map: exact for cells inside the map (a cell outside
+  //   it is dropped, and counted here all the same). O(cells). With `into` a node, the
+  //   cells it already holds are left out (they take nothing new: a restart's root that
+  //   holds earlier scans), at a lookup per cell; kNoNode counts for a fresh node.
+  //   `marks` is scratch of marks_words(max_update_range_m, cell) zeroed words (one bit
+  //   per cell of the square an update can reach around the laser's cell), zeroed again
+  //   on return.
+  std::uint64_t cells_written(const DpMap& map, const ScanRays& rays, const Pose2& robot, double reach_m,
+                              NodeId into, std::uint64_t* marks) const;
+  static std::size_t marks_words(double max_update_range_m, double resolution_m);
 
   // Stopping probability of a cell with these counts (the LUT the hot path uses).
   double stop_probability(const CellObservation& c) const;
@@ -116,9 +131,9 @@ class BeamModel {
 
  private:
   double gauss_mass(double abs_error_m) const;
-  // How far update_map() traces a beam of this kind and range, and whether it ends in a
-  // hit; false iff it traces nothing.
-  bool traced_m(RangeScan::Beam kind, double range_m, double* end_m, bool* hit) const;
+  // How far update_map() traces a beam of this kind and range with update range
+  // `reach_m`, and whether it ends in a hit; false iff it traces nothing.
+  bool traced_m(RangeScan::Beam kind, double range_m, double reach_m, double* end_m, bool* hit) const;
   struct Tracer;
   template <class Lookup>
   double likelihood(const DpMap& map, const ScanRays& rays, const Pose2& robot, std::uint32_t stride,

@@ -218,6 +218,9 @@ class DpMap final : public TreeListener {
   std::uint32_t entries_in_cell(std::int32_t ix, std::int32_t iy) const;
   // Observations owned by `node`. O(1).
   std::uint32_t observation_count(NodeId node) const;
+  // True iff `node` itself (not an ancestor) holds an observation of cell (ix, iy): an
+  // add() there then takes no new observation. Cost as lookup().
+  bool owns(NodeId node, std::int32_t ix, std::int32_t iy) const;
 
   // ---- TreeListener (called by AncestryTree::prune) ----------------------------------
   // Defined inline (no key function), so that the vtable and type info are emitted

@@ -14,8 +14,9 @@
 //      ancestry node's observations (hits at end points, misses along rays) and records
 //      its pose on that node's path; then every drawn particle becomes a new child node
 //      (duplicates of one particle become siblings that inherit the same map). Where the
-//      pool's free room may not hold the writes (BeamModel's bounds), a MapRoom is
-//      first asked to make room;
+//      pool's free room does not hold the writes (BeamModel's counts), a MapRoom is
+//      first asked to make room, and where it cannot make enough the step's update range
+//      is shortened until they fit (far misses are left out; counted);
 //   5. prune/merge the ancestry tree (the DP map follows through TreeListener) and
 //      drain the poses every particle agrees on to the PoseSink.
 // A scan is processed only once the odometry has moved update_min_travel_m or turned
@@ -30,8 +31,11 @@
 //  - node pool full: a drawn particle that cannot get a child node continues on its
 //    parent's node (kept active); its later map updates are then shared with its
 //    siblings. Counted in node_fallback_count.
-//  - observation/tile pool full: the cell update is dropped (map stays consistent, the
-//    particle's map just lacks that evidence). Counted in map_updates_dropped.
+//  - observation pool short of a step's writes: the step writes with a shortened update
+//    range, so that every writer keeps its near cells (map_writes_shortened).
+//  - observation/tile pool full all the same: the cell update is dropped (map stays
+//    consistent, the particle's map just lacks that evidence). Counted in
+//    map_updates_dropped.
 //  - path entries full: the pose is not recorded on the tree (the trajectory has a gap
 //    the caller fills from odometry). Counted by the tree's path_oom_count.
 // Deterministic: same options, seed and input → bit-identical poses.
@@ -95,6 +99,11 @@ struct DpSlamStats {
   // Steps whose map writes might not have fitted in the pool's free room (MapRoom):
   std::uint64_t map_room_asked = 0U;    // ... and the MapRoom was asked for room
   std::uint64_t map_room_short = 0U;    // ... and there was still not room enough after
+  // Writes (a step's, or a restart's scan) made with a shortened update range because the
+  // pool could not hold them at max_update_range_m, and the shortest such range (valid
+  // when map_writes_shortened > 0).
+  std::uint64_t map_writes_shortened = 0U;
+  double shortest_write_reach_m = 0.0;
 };
 
 class DpSlamFilter {
@@ -191,14 +200,16 @@ class DpSlamFilter {
   // the log-weight increment.
   double propose(std::uint32_t i, const Pose2& odom_delta);
   bool is_particle_node(NodeId node) const;
-  // Before step 4: the writers' scans at their proposed poses, bounded, and room asked
-  // for them where the pool's free room may not hold them.
-  void ask_room_for_writes();
-  // ... for one scan written at `pose` into one node (a restart's root).
-  void ask_room_for_scan(const ScanRays& rays, const Pose2& pose);
-  // Asks room_ for `need` observations beyond those in use where fewer are free.
-  void ask_room(std::uint64_t need);
+  // The new observations of writing `rays` with update range `reach_m` (an upper bound
+  // where a write falls outside the map, or into a writer's node that is not fresh): at
+  // `pose` into node `into` (a restart's root), or, pose null, step 4's writers at their
+  // proposed poses.
+  std::uint64_t writes_bound(const ScanRays& rays, const Pose2* pose, NodeId into, double reach_m) const;
+  // The update range those writes are made with: max_update_range_m, after asking room_
+  // for room where the pool's free room does not hold them; shorter where it still cannot.
+  double reach_that_fits(const ScanRays& rays, const Pose2* pose, NodeId into);
   std::uint64_t free_observations() const;
+  static constexpr std::uint32_t kReachBisections = 7U;
   // Step 4 writes particle i's scan into its node.
   bool writes(std::uint32_t i) const;
 
@@ -232,6 +243,7 @@ class DpSlamFilter {
   double* w_ = nullptr;
   std::uint32_t* drawn_ = nullptr;     // resampled indices
   std::uint32_t* counts_ = nullptr;    // children per particle
+  std::uint64_t* marks_ = nullptr;     // BeamModel::cells_written() scratch, zero between calls
   std::uint32_t particle_count_ = 0U;
   std::uint32_t best_index_ = 0U;
 
