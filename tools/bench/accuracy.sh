@@ -18,7 +18,8 @@
 # From each run's stats.json: CPU seconds of the whole run, worst per-scan CPU time, the
 # arena declared at init (the state's size), peak RSS, and the refusals (pools.*.exhausted,
 # pools.*.refused, pools.*.dropped, out_of_map_updates: capacity running out, which the
-# core survives by dropping work).
+# core survives by dropping work), with the bottom level's writes made at a shortened update
+# range (pools.observations.writes_shortened) noted beside them.
 # Every (log or world, seed) pair is one job in its own folder OUT_DIR/{logs,worlds}/NAME/S
 # (run.log, evaluate.json, stats.json, record.tsv); JOBS of them run at once. A failed run
 # or evaluation is recorded as NA, the rest go on, and the script exits 1 after printing
@@ -112,13 +113,15 @@ if "out_of_map_updates" in pools:
     kinds.append(("out_of_map_updates", pools["out_of_map_updates"]))
 refusals = str(sum(n for _, n in kinds)) if st else "NA"
 nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
+obs = pools.get("observations", {})
 rpe = (ev or {}).get("rpe") or {}
 used = ((ev or {}).get("loops") or {}).get("used") or {}
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
                  get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
-                 get(rpe, "mean_m"), get(rpe, "scale_error"), get(used, "count"), get(used, "wrong")]))
+                 get(rpe, "mean_m"), get(rpe, "scale_error"), get(used, "count"), get(used, "wrong"),
+                 get(obs, "writes_shortened"), get(obs, "shortest_write_reach_m")]))
 EOF
-  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\n' \
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\n' \
     "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
   mv "$dir/record.tsv.tmp" "$dir/record.tsv"
   value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
@@ -189,11 +192,11 @@ xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job 
 
 # runs.tsv in job order; a job that left no record counts as failed.
 runs="$out/runs.tsv"
-printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\n' > "$runs"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\twrites_shortened\tshortest_write_reach_m\n' > "$runs"
 while read -r kind name seed; do
   rec="$out/${kind}s/$name/$seed/record.tsv"
   if [ -f "$rec" ]; then cat "$rec"; else
-    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
   fi
 done < "$joblist" >> "$runs"
 
@@ -224,6 +227,11 @@ for (kind, name), rs in groups.items():
     scan, arena, rss, ref = (nums(rs, k) for k in ("scan_cpu_ms_max", "arena_bytes", "peak_rss_kib", "refusals"))
     kinds = sorted({k.split("=")[0] for r in rs if r["refusal_kinds"] != "-" for k in r["refusal_kinds"].split(",")})
     refs = "NA" if not ref else "%d" % sum(ref) + (" (%s)" % ", ".join(kinds) if kinds else "")
+    # Writes the observation pool could only take with a shortened update range (not
+    # refusals: every writer kept its near cells), and the shortest such range.
+    short = [(n, num(r["shortest_write_reach_m"])) for r in rs for n in [num(r["writes_shortened"])] if n]
+    if short:
+        refs += "; %d writes shortened (to %.1f m)" % (sum(n for n, _ in short), min(m for _, m in short))
     # The relative error needs a ground-truth trajectory: the worlds have one, the logs not.
     rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
     drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
