@@ -363,9 +363,10 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
     ++restart_refused_count_;
     return false;
   }
-  // Each scan asks room for itself (MapRoom) before it is written: the root keeps every
-  // write (one node: the scans' common cells are shared), so what one scan adds is bounded
-  // by its own cells. The root is an active leaf, which making room leaves alone.
+  // Each scan's writes are counted, and room asked for them (or the scan's update range
+  // shortened), just before it is written: the root keeps every write (one node: the
+  // scans' common cells are shared), so what one scan adds is its cells the root does not
+  // hold yet. The root is an active leaf, which making room leaves alone.
   for (std::uint32_t k = 0; k < seed_count_; ++k) {
     if (!found[k]) continue;
     const double reach_m = reach_that_fits(seed_rays_[k], &at[k], root);

@@ -96,7 +96,7 @@ struct DpSlamStats {
   std::uint64_t proposal_fallback_empty_map = 0U;   // ... map too empty at the prediction
   std::uint64_t proposal_fallback_low_score = 0U;   // ... match scored below the threshold
   std::uint64_t proposal_evaluations = 0U;          // observation-model calls by the matcher
-  // Steps whose map writes might not have fitted in the pool's free room (MapRoom):
+  // Writes (a step's, or a restart's scan) that did not fit in the pool's free room:
   std::uint64_t map_room_asked = 0U;    // ... and the MapRoom was asked for room
   std::uint64_t map_room_short = 0U;    // ... and there was still not room enough after
   // Writes (a step's, or a restart's scan) made with a shortened update range because the
