@@ -14,7 +14,10 @@
 // Rows: plain walls (only the corridor's end walls constrain the motion along it) or
 // walls with door recesses every 3 m; laser reach 8 m or 30 m; corridor along the grid
 // or turned 0.3 rad to it; the map written from the poses behind the robot only (as in
-// SLAM) or from every pose of the run first (every viewpoint).
+// SLAM) or from every pose of the run first (every viewpoint). The last three columns
+// profile the same scans on a part of their beams only, by angle from the direction of
+// travel (0-30, 30-60 and 60-90 deg to either side): which beams carry the offset.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -37,9 +40,12 @@ struct Case {
   bool every_viewpoint;
 };
 
+constexpr int kSectors = 3;  // beams by angle from the direction of travel, 30 deg each
+
 struct Result {
   double mean_m = 0.0;
   double mean_abs_m = 0.0;
+  double sector_mean_m[kSectors] = {};
   int scans = 0;
 };
 
@@ -83,31 +89,51 @@ bool run_case(const Case& k, Result* out) {
       beam.update_map(map, lineage, *rays, pose_at(kStep_m * i));
     }
   }
+  // The offset of the log-likelihood's maximum along the corridor from `along`, on the
+  // beams of `sector` only (-1: every beam).
+  auto peak_offset = [&](double along, int sector) {
+    std::vector<std::uint8_t> kind(rays->kind, rays->kind + rays->count);
+    if (sector >= 0) {
+      const double lo = sector * M_PI / 6.0;
+      for (std::uint32_t b = 0; b < rays->count; ++b) {
+        const double a = std::fabs(std::atan2(rays->sin_a[b], rays->cos_a[b]));
+        if (!(a >= lo && a < lo + M_PI / 6.0 + (sector == kSectors - 1 ? 1e-9 : 0.0))) {
+          rays->kind[b] = static_cast<std::uint8_t>(RangeScan::Beam::kInvalid);
+        }
+      }
+    }
+    double best = -1e300;
+    double best_offset = 0.0;
+    for (int j = -20; j <= 20; ++j) {
+      const double offset = 0.0025 * j;
+      const double ll = beam.log_likelihood_strided(map, lineage, *rays, pose_at(along + offset), 1U, nullptr);
+      if (ll > best) {
+        best = ll;
+        best_offset = offset;
+      }
+    }
+    std::copy(kind.begin(), kind.end(), rays->kind);
+    return best_offset;
+  };
   double sum = 0.0;
   double sum_abs = 0.0;
+  double sector_sum[kSectors] = {};
   int n = 0;
   for (int i = 0; i < steps; ++i) {
     const double along = kStep_m * i;
     make(pose_at(along));
     if (along > 5.0) {  // some map behind the robot first
-      double best = -1e300;
-      double best_offset = 0.0;
-      for (int j = -20; j <= 20; ++j) {
-        const double offset = 0.0025 * j;
-        const double ll = beam.log_likelihood_strided(map, lineage, *rays, pose_at(along + offset), 1U, nullptr);
-        if (ll > best) {
-          best = ll;
-          best_offset = offset;
-        }
-      }
+      const double best_offset = peak_offset(along, -1);
       sum += best_offset;
       sum_abs += std::fabs(best_offset);
+      for (int q = 0; q < kSectors; ++q) sector_sum[q] += peak_offset(along, q);
       ++n;
     }
     if (!k.every_viewpoint) beam.update_map(map, lineage, *rays, pose_at(along));
   }
   out->mean_m = n > 0 ? sum / n : 0.0;
   out->mean_abs_m = n > 0 ? sum_abs / n : 0.0;
+  for (int q = 0; q < kSectors; ++q) out->sector_mean_m[q] = n > 0 ? sector_sum[q] / n : 0.0;
   out->scans = n;
   return true;
 }
@@ -115,9 +141,9 @@ bool run_case(const Case& k, Result* out) {
 }  // namespace
 
 int main() {
-  std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per %.1f m step | scans |\n",
+  std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per %.1f m step | scans | beams 0-30 deg | beams 30-60 deg | beams 60-90 deg |\n",
               kStep_m);
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   int failed = 0;
   for (bool doors : {false, true}) {
     for (double reach : {8.0, 30.0}) {
@@ -128,9 +154,10 @@ int main() {
             ++failed;
             continue;
           }
-          std::printf("| %s | %.0f m | %.1f rad | %s | %+.1f mm | %.1f mm | %+.2f %% | %d |\n", doors ? "door recesses" : "plain",
-                      reach, heading, every ? "every pose" : "poses behind", r.mean_m * 1e3, r.mean_abs_m * 1e3,
-                      100.0 * r.mean_m / kStep_m, r.scans);
+          std::printf("| %s | %.0f m | %.1f rad | %s | %+.1f mm | %.1f mm | %+.2f %% | %d | %+.1f mm | %+.1f mm | %+.1f mm |\n",
+                      doors ? "door recesses" : "plain", reach, heading, every ? "every pose" : "poses behind",
+                      r.mean_m * 1e3, r.mean_abs_m * 1e3, 100.0 * r.mean_m / kStep_m, r.scans,
+                      r.sector_mean_m[0] * 1e3, r.sector_mean_m[1] * 1e3, r.sector_mean_m[2] * 1e3);
         }
       }
     }
