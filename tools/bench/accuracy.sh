@@ -231,7 +231,7 @@ for (kind, name), rs in groups.items():
     # refusals: every writer kept its near cells), and the shortest such range.
     short = [(n, num(r["shortest_write_reach_m"])) for r in rs for n in [num(r["writes_shortened"])] if n]
     if short:
-        refs += "; %d writes shortened (to %.1f m)" % (sum(n for n, _ in short), min(m for _, m in short))
+        refs += "; %d writes shortened (to %.2f m)" % (sum(n for n, _ in short), min(m for _, m in short))
     # The relative error needs a ground-truth trajectory: the worlds have one, the logs not.
     rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
     drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
