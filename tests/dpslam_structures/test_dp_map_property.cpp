@@ -48,6 +48,7 @@ struct Scenario {
   std::uint32_t observation_capacity;
   std::uint64_t seed;
   bool owner_cell_index = true;
+  bool views = false;  // each particle's updates in a begin_view() .. end_view() run
 };
 
 DpMap::Options scenario_options(const Scenario& s) {
@@ -133,7 +134,11 @@ class PropertyRun {
       CHECK(c != kNoNode);
       naive_[c] = naive_[parent];  // the copy a plain RBPF would make
       next.push_back(c);
-      if (early_updates) random_update(g, c);  // children write before the prune
+      if (early_updates) {  // children write before the prune
+        begin_view(c);
+        random_update(g, c);
+        end_view();
+      }
       check_invariants();
     }
     if (early_updates) compare_views(next);  // provisional labels answer correctly too
@@ -150,7 +155,9 @@ class PropertyRun {
       const std::int64_t stamp_us = static_cast<std::int64_t>(g) * 100000;
       CHECK_TRUE(f_.tree.append_pose(p, stamp_us, Pose2{x_m, 0.0, 0.0}));
       naive_[p].path.push_back({stamp_us, x_m});
+      begin_view(p);
       for (std::uint32_t u = 0; u < s_.updates_per_particle; ++u) random_update(g, p);
+      end_view();
     }
     check_invariants();
     f_.tree.drain_committed(committed_);
@@ -158,6 +165,13 @@ class PropertyRun {
     CHECK(f_.tree.size() <= 2U * s_.particles - 1U);
     compare_views(current_);
     compare_paths();
+  }
+
+  void begin_view(NodeId p) {
+    if (s_.views) f_.map.begin_view(p);
+  }
+  void end_view() {
+    if (s_.views) f_.map.end_view();
   }
 
   void compare_views(const std::vector<NodeId>& particles) {
@@ -239,6 +253,17 @@ TEST(DpMapProperty, every_particle_view_equals_its_naive_map_copy_and_path) {
 // Without the (owner, cell) index every search is the cell-list scan: same views.
 TEST(DpMapProperty, views_equal_the_naive_copies_without_the_owner_cell_index) {
   PropertyRun run(Scenario{12U, 180U, 6U, 32U, 60000U, 11U, false});
+  run.run();
+  LONGS_EQUAL(0, run.refused());
+  CHECK(run.fixture().map.tiles_peak() >= 2U);
+}
+
+// A particle's updates in a begin_view() run (what BeamModel::update_map does) walk the
+// cell lists on per-owner marks: the same views, the first record of a particle too.
+TEST(DpMapProperty, views_equal_the_naive_copies_when_updates_run_in_a_view) {
+  Scenario s{12U, 180U, 6U, 32U, 60000U, 11U, false};
+  s.views = true;
+  PropertyRun run(s);
   run.run();
   LONGS_EQUAL(0, run.refused());
   CHECK(run.fixture().map.tiles_peak() >= 2U);

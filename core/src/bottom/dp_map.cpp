@@ -51,8 +51,9 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   return static_cast<std::uint64_t>(d->tiles_x) * d->tiles_y < 0xFFFFFFFFULL;
 }
 
-// owner → node, node → owner, owner list head, owner count, free-owner stack.
-constexpr std::size_t kOwnerTables = 5U;
+// owner → node, node → owner, owner list head, owner count, free-owner stack, owner →
+// tree sequence, owner → view mark.
+constexpr std::size_t kOwnerTables = 7U;
 
 template <typename T>
 std::size_t pool_bytes(std::uint32_t capacity) {
@@ -112,6 +113,8 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   owner_head_ = owners + 2U * cap;
   owner_count_ = owners + 3U * cap;
   owner_free_ = owners + 4U * cap;
+  owner_tree_ = owners + 5U * cap;
+  owner_mark_ = owners + 6U * cap;
   if (!tiles_pool_.init(arena, options.tile_capacity) || !obs_pool_.init(arena, options.observation_capacity)) {
     return false;
   }
@@ -123,7 +126,12 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
     owner_head_[i] = kNone;
     owner_count_[i] = 0U;
     owner_free_[i] = tree.capacity() - 1U - i;
+    owner_tree_[i] = 0U;
+    owner_mark_[i] = 0U;
   }
+  view_particle_ = kNoNode;
+  view_tree_ = 0U;
+  view_mark_ = 0U;
   owner_free_count_ = tree.capacity();
   options_ = options;
   width_cells_ = d.width_cells;
@@ -239,6 +247,38 @@ std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_
   }
 }
 
+// Marks the owners of `particle`'s ancestors-or-self with a new view mark (a new mark
+// leaves every earlier one stale, so nothing is cleared; a wrapped counter clears all).
+// With the (owner, cell) index the lockstep of find_view() stays: at hundreds of
+// particles, probing the ancestors beats any walk of the list.
+void DpMap::begin_view(NodeId particle) {
+  view_particle_ = kNoNode;
+  if (tree_ == nullptr || index_ != nullptr || !tree_->contains(particle)) return;
+  if (++view_mark_ == 0U) {
+    for (std::uint32_t o = 0U; o < node_capacity_; ++o) owner_mark_[o] = 0U;
+    view_mark_ = 1U;
+  }
+  for (NodeId n = particle; n != kNoNode; n = tree_->parent(n)) {
+    const std::uint32_t o = node_owner_[n];
+    if (o != kNone) owner_mark_[o] = view_mark_;
+  }
+  view_particle_ = particle;
+  view_tree_ = tree_->tree_sequence_unchecked(particle);
+}
+
+// find_view() for the particle of begin_view(): the same walk (the first ancestor-or-self
+// entry is the deepest; the first older tree's entry ends it), with both tests on
+// per-owner tables instead of the node's tree labels.
+std::uint32_t DpMap::find_marked_view(std::uint32_t slot, std::uint32_t c) const {
+  for (std::uint32_t e = tiles_[slot].head[c]; e != kNone;) {
+    const Observation& o = obs_[e];
+    if (owner_mark_[o.owner] == view_mark_) return e;
+    if (owner_tree_[o.owner] < view_tree_) return kNone;
+    e = o.next_in_cell;
+  }
+  return kNone;
+}
+
 void DpMap::index_insert(std::uint32_t e) {
   if (index_ == nullptr) return;
   std::uint32_t i = index_home(obs_[e].owner, obs_[e].location);
@@ -335,6 +375,8 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
     owner = owner_free_[--owner_free_count_];
     owner_node_[owner] = particle;
     node_owner_[particle] = owner;
+    owner_tree_[owner] = tree_->tree_sequence_unchecked(particle);
+    if (particle == view_particle_) owner_mark_[owner] = view_mark_;  // the view's own records
   }
   Observation* o = static_cast<Observation*>(obs_pool_.allocate());  // cannot fail: checked above
   ++observations_made_;
@@ -350,17 +392,16 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
   // entry of any of its descendants. A tree's entries are contiguous, so the walk ends at
   // the first entry of an older tree.
   std::uint32_t prev = kNone;
-  const std::uint32_t own_tree = tree_->tree_sequence_unchecked(particle);
+  const std::uint32_t own_tree = owner_tree_[owner];
   const bool inner = tree_->child_count(particle) > 0U;
   for (std::uint32_t f = tile.head[c]; f != kNone; f = obs_[f].next_in_cell) {
-    const NodeId node = owner_node_[obs_[f].owner];
-    const std::uint32_t entry_tree = tree_->tree_sequence_unchecked(node);
+    const std::uint32_t entry_tree = owner_tree_[obs_[f].owner];
     if (entry_tree > own_tree) {
       prev = f;
       continue;
     }
     if (entry_tree < own_tree || !inner) break;
-    if (tree_->is_ancestor_or_self(particle, node)) prev = f;
+    if (tree_->is_ancestor_or_self(particle, owner_node_[obs_[f].owner])) prev = f;
   }
   const std::uint32_t next = prev == kNone ? tile.head[c] : obs_[prev].next_in_cell;
   o->prev_in_cell = prev;
@@ -397,10 +438,10 @@ bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t
   const std::uint32_t slot = tile_table_[ti];
   CellObservation view{};
   if (slot != kNone) {
-    const std::uint32_t e = find_view(particle, slot, c);
+    const std::uint32_t e = particle == view_particle_ ? find_marked_view(slot, c) : find_view(particle, slot, c);
     if (e != kNone) {
       Observation& o = obs_[e];
-      if (owner_node_[o.owner] == particle) {
+      if (o.owner == node_owner_[particle]) {
         o.value = accumulate(o.value, hits, misses);
         return true;
       }
@@ -677,6 +718,7 @@ bool DpMap::invariants_hold() const {
     ++owners_in_use;
     const NodeId n = owner_node_[o];
     if (n >= node_capacity_ || !tree_->contains(n) || node_owner_[n] != o) return false;
+    if (owner_tree_[o] != tree_->tree_sequence(n)) return false;
     std::uint32_t len = 0U;
     for (std::uint32_t e = owner_head_[o]; e != kNone; e = obs_[e].next_in_node) {
       if (!obs_pool_.slot_in_use(e) || ++in_nodes > obs_total || obs_[e].owner != o) return false;
@@ -710,6 +752,9 @@ void DpMap::transfer_state(StateIo& io) {
   io.value(observations_made_);
   io.value(out_of_bounds_count_);
   io.value(misuse_count_);
+  io.value(view_particle_);
+  io.value(view_tree_);
+  io.value(view_mark_);
 }
 
 }  // namespace sdpslam
