@@ -178,6 +178,7 @@ class PropertyRun {
     for (NodeId p : particles) {
       const NaiveParticle& n = naive_[p];
       std::size_t i = 0U;
+      begin_view(p);
       for (std::int32_t iy = 0; iy < h_; ++iy) {
         for (std::int32_t ix = 0; ix < w_; ++ix, ++i) {
           CellObservation v;
@@ -186,6 +187,7 @@ class PropertyRun {
           if (known && n.known[i] != 0U) CHECK_TRUE(v == n.value[i]);
         }
       }
+      end_view();
     }
   }
 
@@ -258,8 +260,9 @@ TEST(DpMapProperty, views_equal_the_naive_copies_without_the_owner_cell_index) {
   CHECK(run.fixture().map.tiles_peak() >= 2U);
 }
 
-// A particle's updates in a begin_view() run (what BeamModel::update_map does) walk the
-// cell lists on per-owner marks: the same views, the first record of a particle too.
+// A particle's updates and reads in a begin_view() run (what BeamModel::update_map and
+// the scan-matching proposal do) walk the cell lists on per-owner marks: the same
+// views, the first record of a particle too.
 TEST(DpMapProperty, views_equal_the_naive_copies_when_updates_run_in_a_view) {
   Scenario s{12U, 180U, 6U, 32U, 60000U, 11U, false};
   s.views = true;

@@ -239,7 +239,7 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
                                     double reach_m) const {
   const Tracer t(*this, map, rays, robot, reach_m);
   std::uint32_t dropped = 0U;
-  map.begin_view(particle);  // only this particle's add()s until end_view()
+  const DpMap::ViewScope view(map, particle);  // only this particle's add()s meanwhile
   for (std::uint32_t b = 0; b < rays.count; ++b) {
     std::int32_t ex;
     std::int32_t ey;
@@ -251,7 +251,6 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
       return true;
     });
   }
-  map.end_view();
   return dropped;
 }
 

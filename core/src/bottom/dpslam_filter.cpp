@@ -281,6 +281,7 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
 
 double DpSlamFilter::propose(std::uint32_t i, const Pose2& delta) {
   const Particle& p = particles_[i];
+  const DpMap::ViewScope view(map_, p.node);  // the proposal only reads the particle's map
   if (options_.proposal == DpSlamOptions::Proposal::kScanMatch) {
     // Improved proposal (Grisetti et al. 2007, §IV): from the odometry prediction, the
     // mode of the likelihood times the motion model's density along the path.

@@ -196,15 +196,25 @@ class DpMap final : public TreeListener {
   // current view plus the new evidence. Same result and failure rules as update(), with
   // one find_view() (whose answer, if the particle's own, is updated in place).
   bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
-  // A run of add() calls for one particle (a scan's map update) between begin_view() and
-  // end_view(): begin_view() marks the owners of its ancestors-or-self, O(depth), so that
-  // each add() walks the cell list testing one mark and one tree number per entry
-  // (per-owner tables) instead of the entry's node labels: one cache miss per entry
-  // instead of three. Same results as without. Nothing but add() and update() for that
-  // particle may change the map or the tree in between (no prune, no other node's
-  // first record).
+  // A run of reads and add() calls for one particle (a scan's map update, a scan match)
+  // between begin_view() and end_view(): begin_view() marks the owners of its
+  // ancestors-or-self, O(depth), so that each lookup() or add() for it walks the cell
+  // list testing one mark and one tree number per entry (per-owner tables) instead of
+  // the entry's node labels: one cache miss per entry instead of three. Same results as
+  // without. Nothing but add() and update() for that particle may change the map or the
+  // tree in between (no prune, no other node's first record). ViewScope does both.
   void begin_view(NodeId particle);
   void end_view() { view_particle_ = kNoNode; }
+  class ViewScope {
+   public:
+    ViewScope(DpMap& map, NodeId particle) : map_(map) { map_.begin_view(particle); }
+    ~ViewScope() { map_.end_view(); }
+    ViewScope(const ViewScope&) = delete;
+    ViewScope& operator=(const ViewScope&) = delete;
+
+   private:
+    DpMap& map_;
+  };
 
   // Removes the newest observation `node` owns and gives its cell and value: false iff
   // `node` owns none, or is not a live tree node (misuse_count). A root of the forest
@@ -314,7 +324,7 @@ class DpMap final : public TreeListener {
   // Deepest ancestor-or-self of `particle` with an entry in cell `c` of tile slot `slot`.
   bool resolve(NodeId particle, std::uint32_t slot, std::uint32_t c, CellObservation* out) const {
     if (!tree_->contains(particle)) return false;
-    const std::uint32_t e = find_view(particle, slot, c);
+    const std::uint32_t e = particle == view_particle_ ? find_marked_view(slot, c) : find_view(particle, slot, c);
     if (e == kNone) return false;
     *out = obs_[e].value;
     return true;
