@@ -48,7 +48,7 @@ struct Scenario {
   std::uint32_t observation_capacity;
   std::uint64_t seed;
   bool owner_cell_index = true;
-  bool views = false;  // each particle's updates in a begin_view() .. end_view() run
+  bool views = false;  // each particle's updates and reads in a begin_view() .. end_view() run
 };
 
 DpMap::Options scenario_options(const Scenario& s) {
@@ -264,7 +264,7 @@ TEST(DpMapProperty, views_equal_the_naive_copies_without_the_owner_cell_index) {
 // the scan-matching proposal do) walk the cell lists on per-owner marks: the same
 // views, the first record of a particle too.
 TEST(DpMapProperty, views_equal_the_naive_copies_when_updates_run_in_a_view) {
-  Scenario s{12U, 180U, 6U, 32U, 60000U, 11U, false};
+  Scenario s{12U, 180U, 6U, 32U, 60000U, 11U, false};  // without the index: views are used then
   s.views = true;
   PropertyRun run(s);
   run.run();

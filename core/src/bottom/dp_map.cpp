@@ -214,6 +214,7 @@ CellRect DpMap::rect_around(double x0, double y0, double x1, double y1, double p
 }
 
 std::uint32_t DpMap::find_view(NodeId particle, std::uint32_t slot, std::uint32_t c) const {
+  if (particle == view_particle_) return find_marked_view(slot, c);
   std::uint32_t e = tiles_[slot].head[c];
   if (e == kNone) return kNone;
   const std::uint32_t location = (slot << (2U * kSideLog2)) | c;
@@ -438,7 +439,7 @@ bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t
   const std::uint32_t slot = tile_table_[ti];
   CellObservation view{};
   if (slot != kNone) {
-    const std::uint32_t e = particle == view_particle_ ? find_marked_view(slot, c) : find_view(particle, slot, c);
+    const std::uint32_t e = find_view(particle, slot, c);
     if (e != kNone) {
       Observation& o = obs_[e];
       if (o.owner == node_owner_[particle]) {

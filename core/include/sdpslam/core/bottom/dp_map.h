@@ -31,8 +31,8 @@
 // particles a busy cell holds an entry per live lineage, so the scan alone costs O(N)
 // cache misses per cell, while the nearest ancestor with an entry is usually the
 // particle itself or its parent: cost O(min(list position, ancestor distance)).
-// Without the index (SDP-SLAM's few particles per segment) a scan's updates for one
-// particle run in a view (begin_view()): its ancestors' owners are marked once, and the
+// Without the index (SDP-SLAM's few particles per segment) a scan's match and map update
+// for one particle run in a view (begin_view()): its ancestors' owners are marked once, and the
 // scan of each cell list tests per-owner tables (mark, tree sequence) instead of each
 // entry's node labels: one cache miss per entry walked instead of three.
 //
@@ -324,7 +324,7 @@ class DpMap final : public TreeListener {
   // Deepest ancestor-or-self of `particle` with an entry in cell `c` of tile slot `slot`.
   bool resolve(NodeId particle, std::uint32_t slot, std::uint32_t c, CellObservation* out) const {
     if (!tree_->contains(particle)) return false;
-    const std::uint32_t e = particle == view_particle_ ? find_marked_view(slot, c) : find_view(particle, slot, c);
+    const std::uint32_t e = find_view(particle, slot, c);
     if (e == kNone) return false;
     *out = obs_[e].value;
     return true;
@@ -333,6 +333,7 @@ class DpMap final : public TreeListener {
   // the lockstep of the cell-list scan (lists keep every node's entry before its
   // ancestors' entries, see update(), so the first ancestor-or-self found is the
   // deepest) and the ancestor walk probing the index; both exact, first to end wins.
+  // For the particle of begin_view(), find_marked_view().
   std::uint32_t find_view(NodeId particle, std::uint32_t slot, std::uint32_t c) const;
   std::uint32_t find_marked_view(std::uint32_t slot, std::uint32_t c) const;
   // Home slot: a Fibonacci hash of (owner, tile) plus the cell in the tile times 4, so
