@@ -180,6 +180,75 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
   }
 }
 
+// update_map() with its write-combining scratch writes the same map as without it: the
+// same counts in every cell of every node, the same out-of-map writes counted, the same
+// updates reported dropped, and the scratch left zeroed. Several scans go into a root and
+// then into its children (whose first records copy the root's view), some from poses near
+// the map's edge so that beams leave it.
+TEST(BeamModel, write_combining_writes_the_same_map) {
+  std::uint32_t state = 777U;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 1664525U + 1013904223U;
+    return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
+  };
+  const auto world = test::room_world();
+  const BeamModelOptions defaults;
+  std::vector<std::uint64_t> scratch(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
+  for (std::uint32_t trial = 0; trial < 12U; ++trial) {
+    MapFixture plain;
+    MapFixture combined;
+    NodeId plain_node = plain.root;
+    NodeId combined_node = combined.root;
+    for (std::uint32_t k = 0; k < 6U; ++k) {
+      if (k == 3U) {  // the later scans go into a child of the root
+        plain_node = plain.tree.add_child(plain.root);
+        combined_node = combined.tree.add_child(combined.root);
+      }
+      const Pose2 pose{uniform(0.5, 9.5), uniform(0.5, 4.5), uniform(-3.14, 3.14)};
+      if (k % 2U == 0U) {
+        test::make_scan(world, pose, 0, plain.scan.get());
+      } else {  // a dense fan whose long beams leave the map (it ends at x = 15, y = 10)
+        plain.scan->geometry.angle_min_rad = -2.356F;
+        plain.scan->geometry.angle_increment_rad = 0.004363F;
+        plain.scan->geometry.range_min_m = 0.1F;
+        plain.scan->geometry.range_max_m = 12.0F;
+        plain.scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
+        for (std::uint32_t b = 0; b < plain.scan->beam_count; ++b) {
+          plain.scan->ranges_m[b] = static_cast<float>(uniform(0.2, 13.0));
+        }
+      }
+      prepare_rays(*plain.scan, plain.rays.get());
+      const double reach_m = k == 4U ? 2.5 : defaults.max_update_range_m;
+      const std::uint32_t dropped_plain = plain.beam.update_map(plain.map, plain_node, *plain.rays, pose, reach_m);
+      const std::uint32_t dropped_combined =
+          combined.beam.update_map(combined.map, combined_node, *plain.rays, pose, reach_m, scratch.data());
+      LONGS_EQUAL(dropped_plain, dropped_combined);
+      for (const std::uint64_t w : scratch) CHECK_EQUAL(0U, w);
+    }
+    CHECK(plain.map.out_of_bounds_count() > 0U);
+    CHECK_EQUAL(plain.map.out_of_bounds_count(), combined.map.out_of_bounds_count());
+    CHECK_EQUAL(plain.map.observations_used(), combined.map.observations_used());
+    for (const auto& nodes : {std::make_pair(plain.root, combined.root), std::make_pair(plain_node, combined_node)}) {
+      std::vector<std::uint64_t> a;
+      std::vector<std::uint64_t> b;
+      const auto cell = [](std::int32_t ix, std::int32_t iy, const CellObservation& v) {
+        return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(ix) & 0xFFFFU) << 48U) |
+               (static_cast<std::uint64_t>(static_cast<std::uint32_t>(iy) & 0xFFFFU) << 32U) |
+               (static_cast<std::uint64_t>(v.hits) << 16U) | v.misses;
+      };
+      plain.map.for_each_known_cell(nodes.first, [&](std::int32_t ix, std::int32_t iy, const CellObservation& v) {
+        a.push_back(cell(ix, iy, v));
+      });
+      combined.map.for_each_known_cell(nodes.second, [&](std::int32_t ix, std::int32_t iy, const CellObservation& v) {
+        b.push_back(cell(ix, iy, v));
+      });
+      CHECK(a.size() > 1000U);
+      CHECK_TRUE(a == b);
+    }
+    CHECK_TRUE(combined.map.invariants_hold());
+  }
+}
+
 TEST(BeamModel, invalid_options_are_refused) {
   BeamModel b;
   BeamModelOptions o;

@@ -236,18 +236,67 @@ struct BeamModel::Tracer {
 };
 
 std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
-                                    double reach_m) const {
+                                    double reach_m, std::uint64_t* scratch) const {
   const Tracer t(*this, map, rays, robot, reach_m);
   std::uint32_t dropped = 0U;
   const DpMap::ViewScope view(map, particle);  // only this particle's add()s meanwhile
+  const auto write = [&](std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
+    if (!map.add(particle, ix, iy, hits, misses)) dropped += static_cast<std::uint32_t>(hits) + misses;
+  };
+  // The near square: the largest odd square of cells around the laser's cell whose sums
+  // (hits in the low, misses in the high 32 bits of a word) the scratch holds; none
+  // without scratch. Bresenham moves each coordinate one way only, so a beam's cells in
+  // the square are its first ones: pass 1 stops a beam where it leaves the square.
+  static_assert(capacity::kMaxBeams <= 0xFFFFU, "a scan's writes to one cell must fit a DpMap::add()");
+  const std::size_t words = scratch != nullptr ? marks_words(options_.max_update_range_m, resolution_m_) : 0U;
+  std::int32_t side = 1;
+  while (static_cast<std::size_t>(side + 2) * static_cast<std::size_t>(side + 2) <= words) side += 2;
+  const std::int32_t half = words > 0U ? (side - 1) / 2 : -1;
+  const auto in_near = [&](std::int32_t ix, std::int32_t iy) {
+    const std::int64_t dx = static_cast<std::int64_t>(ix) - t.lx;
+    const std::int64_t dy = static_cast<std::int64_t>(iy) - t.ly;
+    return dx >= -half && dx <= half && dy >= -half && dy <= half;
+  };
+  // Pass 1: sum the near square's writes (a cell outside the map goes to add(), which
+  // counts each such write), then write each cell once, row by row.
+  if (half >= 0) {
+    for (std::uint32_t b = 0; b < rays.count; ++b) {
+      std::int32_t ex;
+      std::int32_t ey;
+      bool hit;
+      if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
+      trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
+        if (!in_near(ix, iy)) return false;
+        const bool is_hit = last && hit;
+        if (!map.in_bounds(ix, iy)) {
+          write(ix, iy, is_hit ? 1U : 0U, is_hit ? 0U : 1U);
+        } else {
+          const std::int64_t i = (static_cast<std::int64_t>(iy) - t.ly + half) * side + (ix - t.lx + half);
+          scratch[i] += is_hit ? std::uint64_t{1} : std::uint64_t{1} << 32U;
+        }
+        return true;
+      });
+    }
+    for (std::int32_t y = 0; y < side; ++y) {
+      for (std::int32_t x = 0; x < side; ++x) {
+        std::uint64_t& sum = scratch[static_cast<std::int64_t>(y) * side + x];
+        if (sum == 0U) continue;
+        write(t.lx - half + x, t.ly - half + y, static_cast<std::uint16_t>(sum & 0xFFFFFFFFU),
+              static_cast<std::uint16_t>(sum >> 32U));
+        sum = 0U;
+      }
+    }
+  }
+  // Pass 2: every beam's cells beyond the square, one add() per cell.
   for (std::uint32_t b = 0; b < rays.count; ++b) {
     std::int32_t ex;
     std::int32_t ey;
     bool hit;
     if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
     trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
-      const bool ok = (last && hit) ? map.add(particle, ix, iy, 1U, 0U) : map.add(particle, ix, iy, 0U, 1U);
-      if (!ok) ++dropped;
+      if (in_near(ix, iy)) return true;
+      const bool is_hit = last && hit;
+      write(ix, iy, is_hit ? 1U : 0U, is_hit ? 0U : 1U);
       return true;
     });
   }

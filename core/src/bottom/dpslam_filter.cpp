@@ -146,7 +146,7 @@ void DpSlamFilter::first_scan(const OdometrySample& odom, const RangeScan& scan,
   const NodeId root = tree_.create_root();
   std::uint32_t dropped = 0U;
   if (root != kNoNode) {
-    dropped = beam_.update_map(map_, root, rays_, origin);
+    dropped = beam_.update_map(map_, root, rays_, origin, beam_.options().max_update_range_m, marks_);
     tree_.append_pose(root, scan.stamp_us, origin);
   }
   for (std::uint32_t i = 0; i < particle_count_; ++i) {
@@ -227,7 +227,7 @@ StepResult DpSlamFilter::process(const OdometrySample& odom, const RangeScan& sc
   std::uint32_t dropped = 0U;
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!writes(i)) continue;
-    dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i], reach_m);
+    dropped += beam_.update_map(map_, particles_[i].node, rays_, proposed_[i], reach_m, marks_);
     tree_.append_pose(particles_[i].node, scan.stamp_us, proposed_[i]);
   }
   const double best_lw = log_w_[best];
@@ -371,10 +371,10 @@ bool DpSlamFilter::restart_segment(const Pose2& start_pose) {
   for (std::uint32_t k = 0; k < seed_count_; ++k) {
     if (!found[k]) continue;
     const double reach_m = reach_that_fits(seed_rays_[k], &at[k], root);
-    stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k], reach_m);
+    stats_.map_updates_dropped += beam_.update_map(map_, root, seed_rays_[k], at[k], reach_m, marks_);
   }
   const double reach_m = reach_that_fits(rays_, &start_pose, root);
-  stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose, reach_m);
+  stats_.map_updates_dropped += beam_.update_map(map_, root, rays_, start_pose, reach_m, marks_);
   seed_count_ = 0U;  // the next segment starts from its own scans
   seed_head_ = 0U;
   for (std::uint32_t i = 0; i < particle_count_; ++i) {

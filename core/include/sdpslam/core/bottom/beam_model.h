@@ -101,7 +101,21 @@ class BeamModel {
   // max_update_range_m. A filter whose pool cannot hold a scan's full writes writes its
   // near part this way.
   std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
-                           double reach_m) const;
+                           double reach_m) const {
+    return update_map(map, particle, rays, robot, reach_m, nullptr);
+  }
+  // The same, write-combined through `scratch`: marks_words(max_update_range_m, cell)
+  // zeroed words (cells_written()'s scratch; zeroed again on return), or nullptr to
+  // write every traced cell as it comes. A scan's beams fan out from the laser, so they
+  // cross the cells near it many times over, and every DpMap::add() walks its cell's
+  // list. With scratch, the writes to a square of cells around the laser's cell (as many
+  // as the scratch has words) are summed and each cell is written with one add(); the
+  // cells beyond are written as they come. The map ends the same: counts add, only the
+  // order of first records in the pool differs. The near cells are written first, as a
+  // scan's beams write them first without scratch, so that a pool that runs out drops
+  // far updates. Out-of-map writes count the same.
+  std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot, double reach_m,
+                           std::uint64_t* scratch) const;
   // The new observations one particle's update takes from the pool (its node is fresh)
   // are the distinct cells update_map() writes.
   // - An upper bound at any pose: Bresenham moves one cell along the longer axis per

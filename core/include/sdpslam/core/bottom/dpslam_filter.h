@@ -243,7 +243,7 @@ class DpSlamFilter {
   double* w_ = nullptr;
   std::uint32_t* drawn_ = nullptr;     // resampled indices
   std::uint32_t* counts_ = nullptr;    // children per particle
-  std::uint64_t* marks_ = nullptr;     // BeamModel::cells_written() scratch, zero between calls
+  std::uint64_t* marks_ = nullptr;     // scratch of cells_written() and update_map(), zero between calls
   std::uint32_t particle_count_ = 0U;
   std::uint32_t best_index_ = 0U;
 
