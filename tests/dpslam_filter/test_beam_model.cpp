@@ -38,6 +38,27 @@ struct MapFixture {
     root = tree.create_root();
   }
 };
+
+// A small deterministic generator for test poses and ranges.
+struct Lcg {
+  std::uint32_t state;
+  double uniform(double lo, double hi) {
+    state = state * 1664525U + 1013904223U;
+    return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
+  }
+};
+
+// Every beam of a 270-degree 1081-beam laser (as many as a scan holds), ranges drawn by
+// range_m(); readings at or beyond range_max_m are no-returns.
+template <class Draw>
+void dense_fan(RangeScan* scan, float range_max_m, Draw&& range_m) {
+  scan->geometry.angle_min_rad = -2.356F;
+  scan->geometry.angle_increment_rad = 0.004363F;
+  scan->geometry.range_min_m = 0.1F;
+  scan->geometry.range_max_m = range_max_m;
+  scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
+  for (std::uint32_t b = 0; b < scan->beam_count; ++b) scan->ranges_m[b] = static_cast<float>(range_m());
+}
 }  // namespace
 
 TEST_GROUP(BeamModel){};
@@ -117,11 +138,8 @@ TEST(BeamModel, beams_leaving_the_map_are_counted_as_dropped_not_fatal) {
 // that holds some of the cells already. Both hold for a write with a shortened update
 // range too.
 TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
-  std::uint32_t state = 12345U;
-  const auto uniform = [&state](double lo, double hi) {
-    state = state * 1664525U + 1013904223U;
-    return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
-  };
+  Lcg lcg{12345U};
+  const auto uniform = [&lcg](double lo, double hi) { return lcg.uniform(lo, hi); };
   const auto world = test::room_world();
   const BeamModelOptions defaults;
   std::vector<std::uint64_t> marks(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
@@ -137,14 +155,9 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
     if (trial % 2U == 0U) {
       test::make_scan(world, pose, 0, f.scan.get());
     } else {
-      // a dense fan: every beam of a 270-degree 1081-beam laser, ranges to 6 m, some
-      // beyond max_update_range_m's stand-in (range_max_m: no return)
-      f.scan->geometry.angle_min_rad = -2.356F;
-      f.scan->geometry.angle_increment_rad = 0.004363F;
-      f.scan->geometry.range_min_m = 0.1F;
-      f.scan->geometry.range_max_m = 5.5F;
-      f.scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
-      for (std::uint32_t b = 0; b < f.scan->beam_count; ++b) f.scan->ranges_m[b] = static_cast<float>(uniform(0.2, 6.0));
+      // a dense fan, ranges to 6 m, some beyond max_update_range_m's stand-in
+      // (range_max_m: no return)
+      dense_fan(f.scan.get(), 5.5F, [&] { return uniform(0.2, 6.0); });
     }
     prepare_rays(*f.scan, f.rays.get());
     const std::uint64_t counted =
@@ -186,11 +199,8 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
 // then into its children (whose first records copy the root's view), some from poses near
 // the map's edge so that beams leave it.
 TEST(BeamModel, write_combining_writes_the_same_map) {
-  std::uint32_t state = 777U;
-  const auto uniform = [&state](double lo, double hi) {
-    state = state * 1664525U + 1013904223U;
-    return lo + (hi - lo) * static_cast<double>(state >> 8U) / static_cast<double>(1U << 24U);
-  };
+  Lcg lcg{777U};
+  const auto uniform = [&lcg](double lo, double hi) { return lcg.uniform(lo, hi); };
   const auto world = test::room_world();
   const BeamModelOptions defaults;
   std::vector<std::uint64_t> scratch(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
@@ -208,14 +218,7 @@ TEST(BeamModel, write_combining_writes_the_same_map) {
       if (k % 2U == 0U) {
         test::make_scan(world, pose, 0, plain.scan.get());
       } else {  // a dense fan whose long beams leave the map (it ends at x = 15, y = 10)
-        plain.scan->geometry.angle_min_rad = -2.356F;
-        plain.scan->geometry.angle_increment_rad = 0.004363F;
-        plain.scan->geometry.range_min_m = 0.1F;
-        plain.scan->geometry.range_max_m = 12.0F;
-        plain.scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
-        for (std::uint32_t b = 0; b < plain.scan->beam_count; ++b) {
-          plain.scan->ranges_m[b] = static_cast<float>(uniform(0.2, 13.0));
-        }
+        dense_fan(plain.scan.get(), 12.0F, [&] { return uniform(0.2, 13.0); });
       }
       prepare_rays(*plain.scan, plain.rays.get());
       const double reach_m = k == 4U ? 2.5 : defaults.max_update_range_m;

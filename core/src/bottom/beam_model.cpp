@@ -233,6 +233,19 @@ struct BeamModel::Tracer {
     *ey = floor_cell((lf.y_m + end_m * dy - oy) * inv_res);
     return true;
   }
+  // f(ix, iy, hit) for the cells of every traced beam, each beam from the laser's cell to
+  // its end cell (hit: the end cell of a beam that ends in a hit); f returns false to
+  // stop tracing that beam.
+  template <class F>
+  void each_cell(const BeamModel& m, const ScanRays& rays, F&& f) const {
+    for (std::uint32_t b = 0; b < rays.count; ++b) {
+      std::int32_t ex;
+      std::int32_t ey;
+      bool hit;
+      if (!end_cell(m, rays, b, &ex, &ey, &hit)) continue;
+      trace_cells(lx, ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) { return f(ix, iy, last && hit); });
+    }
+  }
 };
 
 std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot,
@@ -260,23 +273,16 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
   // Pass 1: sum the near square's writes (a cell outside the map goes to add(), which
   // counts each such write), then write each cell once, row by row.
   if (half >= 0) {
-    for (std::uint32_t b = 0; b < rays.count; ++b) {
-      std::int32_t ex;
-      std::int32_t ey;
-      bool hit;
-      if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
-      trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
-        if (!in_near(ix, iy)) return false;
-        const bool is_hit = last && hit;
-        if (!map.in_bounds(ix, iy)) {
-          write(ix, iy, is_hit ? 1U : 0U, is_hit ? 0U : 1U);
-        } else {
-          const std::int64_t i = (static_cast<std::int64_t>(iy) - t.ly + half) * side + (ix - t.lx + half);
-          scratch[i] += is_hit ? std::uint64_t{1} : std::uint64_t{1} << 32U;
-        }
-        return true;
-      });
-    }
+    t.each_cell(*this, rays, [&](std::int32_t ix, std::int32_t iy, bool hit) {
+      if (!in_near(ix, iy)) return false;
+      if (!map.in_bounds(ix, iy)) {
+        write(ix, iy, hit ? 1U : 0U, hit ? 0U : 1U);
+      } else {
+        const std::int64_t i = (static_cast<std::int64_t>(iy) - t.ly + half) * side + (ix - t.lx + half);
+        scratch[i] += hit ? std::uint64_t{1} : std::uint64_t{1} << 32U;
+      }
+      return true;
+    });
     for (std::int32_t y = 0; y < side; ++y) {
       for (std::int32_t x = 0; x < side; ++x) {
         std::uint64_t& sum = scratch[static_cast<std::int64_t>(y) * side + x];
@@ -288,18 +294,10 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
     }
   }
   // Pass 2: every beam's cells beyond the square, one add() per cell.
-  for (std::uint32_t b = 0; b < rays.count; ++b) {
-    std::int32_t ex;
-    std::int32_t ey;
-    bool hit;
-    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
-    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
-      if (in_near(ix, iy)) return true;
-      const bool is_hit = last && hit;
-      write(ix, iy, is_hit ? 1U : 0U, is_hit ? 0U : 1U);
-      return true;
-    });
-  }
+  t.each_cell(*this, rays, [&](std::int32_t ix, std::int32_t iy, bool hit) {
+    if (!in_near(ix, iy)) write(ix, iy, hit ? 1U : 0U, hit ? 0U : 1U);
+    return true;
+  });
   return dropped;
 }
 
@@ -326,27 +324,21 @@ std::uint64_t BeamModel::cells_written(const DpMap& map, const ScanRays& rays, c
   const std::int32_t half = marks_half(options_.max_update_range_m, resolution_m_);
   const std::int64_t side = 2 * static_cast<std::int64_t>(half) + 1;
   std::uint64_t cells = 0U;
-  for (std::uint32_t b = 0; b < rays.count; ++b) {
-    std::int32_t ex;
-    std::int32_t ey;
-    bool hit;
-    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
-    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool) {
-      const std::int64_t mx = static_cast<std::int64_t>(ix) - t.lx + half;
-      const std::int64_t my = static_cast<std::int64_t>(iy) - t.ly + half;
-      if (mx < 0 || my < 0 || mx >= side || my >= side) {
-        ++cells;  // cannot happen (the square holds every traced cell); counted anyway
-        return true;
-      }
-      const auto bit = static_cast<std::uint64_t>(my * side + mx);
-      const std::uint64_t mask = std::uint64_t{1} << (bit & 63U);
-      if ((marks[bit >> 6U] & mask) == 0U) {
-        marks[bit >> 6U] |= mask;
-        if (into == kNoNode || !map.owns(into, ix, iy)) ++cells;
-      }
+  t.each_cell(*this, rays, [&](std::int32_t ix, std::int32_t iy, bool) {
+    const std::int64_t mx = static_cast<std::int64_t>(ix) - t.lx + half;
+    const std::int64_t my = static_cast<std::int64_t>(iy) - t.ly + half;
+    if (mx < 0 || my < 0 || mx >= side || my >= side) {
+      ++cells;  // cannot happen (the square holds every traced cell); counted anyway
       return true;
-    });
-  }
+    }
+    const auto bit = static_cast<std::uint64_t>(my * side + mx);
+    const std::uint64_t mask = std::uint64_t{1} << (bit & 63U);
+    if ((marks[bit >> 6U] & mask) == 0U) {
+      marks[bit >> 6U] |= mask;
+      if (into == kNoNode || !map.owns(into, ix, iy)) ++cells;
+    }
+    return true;
+  });
   std::memset(marks, 0, marks_words(options_.max_update_range_m, resolution_m_) * sizeof(std::uint64_t));
   return cells;
 }
