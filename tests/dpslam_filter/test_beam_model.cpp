@@ -59,6 +59,12 @@ void dense_fan(RangeScan* scan, float range_max_m, Draw&& range_m) {
   scan->beam_count = capacity::kMaxBeams < 1081U ? capacity::kMaxBeams : 1081U;
   for (std::uint32_t b = 0; b < scan->beam_count; ++b) scan->ranges_m[b] = static_cast<float>(range_m());
 }
+
+// The scratch of cells_written() and update_map() for the default options at 0.05 m
+// cells, zeroed.
+std::vector<std::uint64_t> default_scratch() {
+  return std::vector<std::uint64_t>(BeamModel::marks_words(BeamModelOptions{}.max_update_range_m, 0.05));
+}
 }  // namespace
 
 TEST_GROUP(BeamModel){};
@@ -139,10 +145,9 @@ TEST(BeamModel, beams_leaving_the_map_are_counted_as_dropped_not_fatal) {
 // range too.
 TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
   Lcg lcg{12345U};
-  const auto uniform = [&lcg](double lo, double hi) { return lcg.uniform(lo, hi); };
   const auto world = test::room_world();
   const BeamModelOptions defaults;
-  std::vector<std::uint64_t> marks(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
+  std::vector<std::uint64_t> marks = default_scratch();
   const auto all_zero = [&marks] {
     for (const std::uint64_t w : marks) {
       if (w != 0U) return false;
@@ -151,13 +156,13 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
   };
   for (std::uint32_t trial = 0; trial < 40U; ++trial) {
     MapFixture f;
-    const Pose2 pose{uniform(1.0, 9.0), uniform(1.0, 4.0), uniform(-3.14, 3.14)};
+    const Pose2 pose{lcg.uniform(1.0, 9.0), lcg.uniform(1.0, 4.0), lcg.uniform(-3.14, 3.14)};
     if (trial % 2U == 0U) {
       test::make_scan(world, pose, 0, f.scan.get());
     } else {
       // a dense fan, ranges to 6 m, some beyond max_update_range_m's stand-in
       // (range_max_m: no return)
-      dense_fan(f.scan.get(), 5.5F, [&] { return uniform(0.2, 6.0); });
+      dense_fan(f.scan.get(), 5.5F, [&] { return lcg.uniform(0.2, 6.0); });
     }
     prepare_rays(*f.scan, f.rays.get());
     const std::uint64_t counted =
@@ -173,7 +178,7 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
     if (trial % 2U == 1U) CHECK(bound <= 2U * written);
     // A write with a shortened update range.
     MapFixture g;
-    const double reach_m = uniform(0.0, 4.0);
+    const double reach_m = lcg.uniform(0.0, 4.0);
     const std::uint64_t counted_short = g.beam.cells_written(g.map, *f.rays, pose, reach_m, kNoNode, marks.data());
     LONGS_EQUAL(0, g.beam.update_map(g.map, g.root, *f.rays, pose, reach_m));
     const std::uint64_t shortened = g.map.observations_used();
@@ -200,10 +205,9 @@ TEST(BeamModel, the_cells_bound_holds_at_every_pose_and_the_count_is_exact) {
 // the map's edge so that beams leave it.
 TEST(BeamModel, write_combining_writes_the_same_map) {
   Lcg lcg{777U};
-  const auto uniform = [&lcg](double lo, double hi) { return lcg.uniform(lo, hi); };
   const auto world = test::room_world();
   const BeamModelOptions defaults;
-  std::vector<std::uint64_t> scratch(BeamModel::marks_words(defaults.max_update_range_m, 0.05));
+  std::vector<std::uint64_t> scratch = default_scratch();
   for (std::uint32_t trial = 0; trial < 12U; ++trial) {
     MapFixture plain;
     MapFixture combined;
@@ -214,11 +218,11 @@ TEST(BeamModel, write_combining_writes_the_same_map) {
         plain_node = plain.tree.add_child(plain.root);
         combined_node = combined.tree.add_child(combined.root);
       }
-      const Pose2 pose{uniform(0.5, 9.5), uniform(0.5, 4.5), uniform(-3.14, 3.14)};
+      const Pose2 pose{lcg.uniform(0.5, 9.5), lcg.uniform(0.5, 4.5), lcg.uniform(-3.14, 3.14)};
       if (k % 2U == 0U) {
         test::make_scan(world, pose, 0, plain.scan.get());
       } else {  // a dense fan whose long beams leave the map (it ends at x = 15, y = 10)
-        dense_fan(plain.scan.get(), 12.0F, [&] { return uniform(0.2, 13.0); });
+        dense_fan(plain.scan.get(), 12.0F, [&] { return lcg.uniform(0.2, 13.0); });
       }
       prepare_rays(*plain.scan, plain.rays.get());
       const double reach_m = k == 4U ? 2.5 : defaults.max_update_range_m;
