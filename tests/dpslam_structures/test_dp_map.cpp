@@ -463,6 +463,43 @@ TEST(DpMap, footprint_reports_the_fixed_storage) {
   CHECK(f.map.footprint_bytes() >= 100U * 20U + 4U * 1024U + 9U * 4U);
 }
 
+TEST(DpMap, an_observation_slot_costs_its_entry_alone_and_freed_slots_are_reused) {
+  // Without the index, 100 more observations cost exactly 100 entries: no per-slot
+  // bookkeeping beside them, in the arena or in the footprint.
+  DpMap::Options small = small_options(9U, 100U);
+  small.owner_cell_index = false;
+  DpMap::Options big = small;
+  big.observation_capacity = 200U;
+  LONGS_EQUAL(100U * DpMap::kObservationBytes,
+              DpMap::required_arena_bytes(big, 8U) - DpMap::required_arena_bytes(small, 8U));
+  DpFixture fs(8U, 8U, small);
+  DpFixture fb(8U, 8U, big);
+  LONGS_EQUAL(100U * DpMap::kObservationBytes, fb.map.footprint_bytes() - fs.map.footprint_bytes());
+  // Fill the pool, free it, fill it again: every slot comes back, the peak stays.
+  DpFixture f(8U, 8U, small);
+  auto& t = f.tree;
+  for (int round = 0; round < 2; ++round) {
+    const NodeId r = t.create_root();
+    for (std::int32_t i = 0; i < 100; ++i) CHECK_TRUE(f.map.update(r, i % 48, i / 48, obs(1, 0)));
+    CHECK_FALSE(f.map.update(r, 47, 39, obs(1, 0)));
+    LONGS_EQUAL(100U, f.map.observations_used());
+    LONGS_EQUAL(100U, f.map.observations_peak());
+    LONGS_EQUAL(round + 1, f.map.observation_oom_count());
+    CHECK_TRUE(f.map.invariants_hold());
+    // Free half by popping, then the rest with the node.
+    std::int32_t ix;
+    std::int32_t iy;
+    CellObservation v;
+    for (int k = 0; k < 50; ++k) CHECK_TRUE(f.map.pop_observation(r, &ix, &iy, &v));
+    LONGS_EQUAL(50U, f.map.observations_used());
+    CHECK_TRUE(f.map.invariants_hold());
+    t.set_active(r, false);
+    t.prune(&f.map);
+    LONGS_EQUAL(0U, f.map.observations_used());
+    CHECK_TRUE(f.map.invariants_hold());
+  }
+}
+
 TEST(DpMap, views_stay_exact_across_a_forest_when_an_older_tree_is_written_after_newer_ones) {
   // SDP-SLAM's case: every segment is a new tree, and the global map's root (an older
   // tree) keeps being written. Lookups skip newer trees and stop at older ones.

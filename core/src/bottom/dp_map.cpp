@@ -2,6 +2,8 @@
 #include "sdpslam/core/bottom/dp_map.h"
 
 #include <cmath>
+#include <cstdint>
+#include <new>
 
 namespace sdpslam {
 
@@ -31,6 +33,8 @@ bool grid_dims(const DpMap::Options& o, GridDims* d) {
   if (!(o.resolution_m > 0.0) || !(o.width_m > 0.0) || !(o.height_m > 0.0)) return false;
   if (o.tile_capacity == 0U || o.tile_capacity > capacity::kDpMaxTiles || o.observation_capacity == 0U) return false;
   if (o.observation_capacity > capacity::kDpMaxObservations) return false;  // index_slots_for() < 2^31
+  // The observation slots' bytes fit a size_t with room for the rest (32-bit targets).
+  if (std::uint64_t{o.observation_capacity} * DpMap::kObservationBytes > SIZE_MAX / 2U) return false;
   d->width_cells = cells_for(o.width_m, o.resolution_m);
   d->height_cells = cells_for(o.height_m, o.resolution_m);
   if (d->width_cells <= 0 || d->height_cells <= 0) return false;
@@ -83,8 +87,8 @@ std::size_t DpMap::required_arena_bytes(const Options& options, std::uint32_t no
   return sizeof(std::uint32_t) * (static_cast<std::size_t>(d.tiles_x) * d.tiles_y + kOwnerTables * node_capacity) +
          3U * alignof(std::uint32_t) +
          (options.owner_cell_index ? sizeof(std::uint32_t) * index_slots_for(options.observation_capacity) : 0U) +
-         pool_bytes<Tile>(options.tile_capacity) +
-         pool_bytes<Observation>(options.observation_capacity);
+         pool_bytes<Tile>(options.tile_capacity) + sizeof(Observation) * options.observation_capacity +
+         alignof(Observation);
 }
 
 bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree) {
@@ -115,9 +119,16 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   owner_free_ = owners + 4U * cap;
   owner_tree_ = owners + 5U * cap;
   owner_mark_ = owners + 6U * cap;
-  if (!tiles_pool_.init(arena, options.tile_capacity) || !obs_pool_.init(arena, options.observation_capacity)) {
-    return false;
-  }
+  // Raw slots, not value-initialised: a slot's memory is first touched when it is handed
+  // out, so slots the map never needs are never paged in.
+  obs_ = static_cast<Observation*>(
+      arena.allocate(sizeof(Observation) * std::size_t{options.observation_capacity}, alignof(Observation)));
+  if (obs_ == nullptr || !tiles_pool_.init(arena, options.tile_capacity)) return false;
+  obs_capacity_ = options.observation_capacity;
+  obs_fresh_ = 0U;
+  obs_used_ = 0U;
+  obs_peak_ = 0U;
+  obs_free_ = kNone;
   for (std::size_t i = 0; i < table_entries; ++i) tile_table_[i] = kNone;
   // Free stack popped from the top: owner 0 is handed out first.
   for (std::uint32_t i = 0; i < tree.capacity(); ++i) {
@@ -143,7 +154,6 @@ bool DpMap::init(Arena& arena, const Options& options, const AncestryTree& tree)
   tile_mask_y_ = wrap_ ? tiles_y_ - 1U : 0xFFFFFFFFU;
   node_capacity_ = tree.capacity();
   tiles_ = nullptr;
-  obs_ = nullptr;
   tree_ = &tree;
   return true;
 }
@@ -343,7 +353,7 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
   std::uint32_t owner = node_owner_[particle];
   // A new entry is needed. Check the observation pool first so that a refused update
   // never allocates (and then has to release) a tile.
-  if (obs_pool_.full()) {
+  if (obs_free_ == kNone && obs_fresh_ == obs_capacity_) {
     ++observation_oom_count_;
     return false;
   }
@@ -379,10 +389,12 @@ bool DpMap::insert(NodeId particle, std::uint32_t ti, std::uint32_t c, CellObser
     owner_tree_[owner] = tree_->tree_sequence_unchecked(particle);
     if (particle == view_particle_) owner_mark_[owner] = view_mark_;  // the view's own records
   }
-  Observation* o = static_cast<Observation*>(obs_pool_.allocate());  // cannot fail: checked above
+  // The last slot freed, else the first never used (checked above: one of them exists).
+  const std::uint32_t e = obs_free_ != kNone ? obs_free_ : obs_fresh_++;
+  if (e == obs_free_) obs_free_ = obs_[e].next_in_node;
+  Observation* o = new (&obs_[e]) Observation();
+  if (++obs_used_ > obs_peak_) obs_peak_ = obs_used_;
   ++observations_made_;
-  const std::uint32_t e = obs_pool_.index_of(o);
-  obs_ = o - e;
   Tile& tile = tiles_[slot];
   o->owner = owner;
   o->value = value;
@@ -471,7 +483,10 @@ void DpMap::release_observation(std::uint32_t e) {
     tile_table_[tile.table_index] = kNone;
     tiles_pool_.release(&tile);
   }
-  obs_pool_.release(&obs_[e]);
+  obs_[e].owner = kNone;
+  obs_[e].next_in_node = obs_free_;
+  obs_free_ = e;
+  --obs_used_;
 }
 
 bool DpMap::pop_observation(NodeId node, std::int32_t* ix, std::int32_t* iy, CellObservation* value) {
@@ -647,13 +662,23 @@ bool DpMap::owns(NodeId node, std::int32_t ix, std::int32_t iy) const {
 std::size_t DpMap::footprint_bytes() const {
   return sizeof(std::uint32_t) * (static_cast<std::size_t>(tiles_x_) * tiles_y_ + kOwnerTables * node_capacity_ +
                                   static_cast<std::size_t>(index_mask_) + 1U) +
-         tiles_pool_.footprint_bytes() + obs_pool_.footprint_bytes();
+         tiles_pool_.footprint_bytes() + sizeof(Observation) * obs_capacity_;
 }
 
 bool DpMap::invariants_hold() const {
   if (tree_ == nullptr) return true;
-  if (!tiles_pool_.invariants_hold() || !obs_pool_.invariants_hold()) return false;
-  const std::uint32_t obs_total = obs_pool_.size();
+  if (!tiles_pool_.invariants_hold() || obs_ == nullptr) return false;
+  // Observation slots: the free stack holds exactly the slots handed out and not in use
+  // (owner kNone); those never handed out are the rest.
+  const std::uint32_t obs_total = obs_used_;
+  if (obs_fresh_ > obs_capacity_ || obs_used_ > obs_fresh_ || obs_peak_ < obs_used_ || obs_peak_ > obs_fresh_) {
+    return false;
+  }
+  std::uint32_t obs_free_seen = 0U;
+  for (std::uint32_t e = obs_free_; e != kNone; e = obs_[e].next_in_node) {
+    if (e >= obs_fresh_ || obs_[e].owner != kNone || ++obs_free_seen > obs_fresh_ - obs_used_) return false;
+  }
+  if (obs_free_seen != obs_fresh_ - obs_used_) return false;
   // Cells: each tile in use is referenced once, knows its table entry, counts its
   // entries, is not empty; each entry is live, addresses this cell, belongs to a live
   // tree node, and no node appears twice in one cell.
@@ -670,7 +695,7 @@ bool DpMap::invariants_hold() const {
     for (std::uint32_t c = 0U; c < capacity::kDpTileCells; ++c) {
       std::uint32_t prev = kNone;
       for (std::uint32_t e = tile.head[c]; e != kNone; prev = e, e = obs_[e].next_in_cell) {
-        if (!obs_pool_.slot_in_use(e) || ++in_cells > obs_total) return false;
+        if (!obs_in_use(e) || ++in_cells > obs_total) return false;
         ++in_tile;
         const Observation& o = obs_[e];
         if (o.prev_in_cell != prev) return false;
@@ -694,7 +719,7 @@ bool DpMap::invariants_hold() const {
   for (std::size_t i = 0U; index_ != nullptr && i <= index_mask_; ++i) {
     const std::uint32_t e = index_[i];
     if (e == kNone) continue;
-    if (!obs_pool_.slot_in_use(e) || ++indexed > obs_total) return false;
+    if (!obs_in_use(e) || ++indexed > obs_total) return false;
   }
   if (indexed != obs_total) return false;
   // Owners: the free stack holds distinct owners not in use; an owner in use (not on
@@ -722,7 +747,7 @@ bool DpMap::invariants_hold() const {
     if (owner_tree_[o] != tree_->tree_sequence(n)) return false;
     std::uint32_t len = 0U;
     for (std::uint32_t e = owner_head_[o]; e != kNone; e = obs_[e].next_in_node) {
-      if (!obs_pool_.slot_in_use(e) || ++in_nodes > obs_total || obs_[e].owner != o) return false;
+      if (!obs_in_use(e) || ++in_nodes > obs_total || obs_[e].owner != o) return false;
       ++len;
     }
     if (len == 0U || len != owner_count_[o]) return false;
@@ -739,7 +764,13 @@ bool DpMap::invariants_hold() const {
 void DpMap::transfer_state(StateIo& io) {
   io.section("dp_map");
   tiles_pool_.transfer_state(io);
-  obs_pool_.transfer_state(io);
+  std::uint32_t obs_capacity = obs_capacity_;
+  io.value(obs_capacity);
+  if (io.ok() && obs_capacity != obs_capacity_) io.fail("dp map observation capacity differs", nullptr);
+  io.value(obs_fresh_);
+  io.value(obs_used_);
+  io.value(obs_peak_);
+  io.value(obs_free_);
   // Slot 0 of each pool, set by the first allocation.
   io.arena_pointer(tiles_, "dp map tiles");
   io.arena_pointer(obs_, "dp map observations");

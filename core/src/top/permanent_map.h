@@ -23,8 +23,9 @@
 // no data.
 //
 // Compared with keeping the permanent map as one more node of the DP map, it costs 8
-// bytes per cell of each touched tile instead of ~32 bytes per known cell (an
-// observation slot and its pool links) in the shared observation pool, so the bottom level's map no longer competes with it.
+// bytes per cell of each touched tile instead of 24 bytes per known cell (an
+// observation slot) in the shared observation pool, so the bottom level's map no longer
+// competes with it.
 //
 // Full store: compacted, not lost (issue: memory is fixed, the world is not). When a
 // write needs a new tile and every tile is taken, the whole map is coarsened once:

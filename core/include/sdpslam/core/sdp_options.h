@@ -80,12 +80,15 @@ struct SdpOptions {
   bool defer_top_work = false;
   // [sdp] fixed memory of the shared DP map in SDP mode (0 = keep the [map] values):
   // tiles that may hold data and observations for every live submap (the permanent
-  // submaps go to the permanent map below). The state's 64 MiB budget is what sizes
-  // them: tiles with room to spare for an office floor's live submaps, observations the
-  // rest. Where the pool runs short, older levels become permanent early, before a
-  // segment starts and before any scan's writes (counted at the particles' poses); only
-  // a segment that alone outgrows the pool has a scan's writes made with a shortened
-  // update range, each one counted (stats.json pools.observations.writes_shortened).
+  // submaps go to the permanent map below): tiles with room to spare for an office
+  // floor's live submaps, and 1.5 million observations (24 B each, 36 MB), which keeps
+  // the default state well inside its 64 MiB budget. A larger pool keeps more levels
+  // live in wide spaces, where it also makes longer segments (fewer end for the pool),
+  // so it is not simply better. Where the pool runs short, older levels become
+  // permanent early, before a segment starts and before any scan's writes (counted at
+  // the particles' poses); only a segment that alone outgrows the pool has a scan's
+  // writes made with a shortened update range, each one counted (stats.json
+  // pools.observations.writes_shortened).
   std::uint32_t map_tile_capacity = 2500U;
   std::uint32_t map_observation_capacity = 1505000U;
   // [sdp] tiles of the global map's permanent part (permanent_map.h), 16 × 16 cells of

@@ -13,7 +13,13 @@
 //  - tiles (cell list heads) from a pool, allocated on the first write into the tile and
 //    released when their last observation goes, so unexplored space costs 4 bytes/tile;
 //  - observations (24 bytes: owner, cell links both ways, owner link, cell address,
-//    value) from a pool; the cell list is doubly linked so that a release is O(1). An observation names an *owner* slot, not a node: owner → node and
+//    value) in one array with its own free list: the last slot freed is handed out
+//    first, else the first never used; a freed slot (owner kNone) links to the one
+//    freed before it through its owner link. So a slot costs its 24 bytes and nothing
+//    beside them (a general pool's free links and generations would add a third, and a
+//    cache miss to every allocation and release), and a slot the map never needs is
+//    never touched. The cell list is doubly linked so that a release is O(1). An
+//    observation names an *owner* slot, not a node: owner → node and
 //    node → owner tables (one owner per node that has observations, sized by the tree's
 //    capacity) add one indirection to lookups and make a merge cost O(smaller side).
 //    Each owner keeps an intrusive list of its observations and their count;
@@ -263,9 +269,9 @@ class DpMap final : public TreeListener {
   std::uint32_t tiles_used() const { return tiles_pool_.size(); }
   std::uint32_t tiles_peak() const { return tiles_pool_.peak_used(); }
   std::uint32_t tile_capacity() const { return tiles_pool_.capacity(); }
-  std::uint32_t observations_used() const { return obs_pool_.size(); }
-  std::uint32_t observations_peak() const { return obs_pool_.peak_used(); }
-  std::uint32_t observation_capacity() const { return obs_pool_.capacity(); }
+  std::uint32_t observations_used() const { return obs_used_; }
+  std::uint32_t observations_peak() const { return obs_peak_; }
+  std::uint32_t observation_capacity() const { return obs_capacity_; }
   std::uint64_t tile_oom_count() const { return tile_oom_count_; }
   std::uint64_t observation_oom_count() const { return observation_oom_count_; }
   // New (node, cell) observations asked for since init: made, or refused for a full pool.
@@ -371,6 +377,7 @@ class DpMap final : public TreeListener {
   void merge_node(NodeId parent, NodeId child);
   void unlink_from_cell(std::uint32_t e);
   void release_observation(std::uint32_t e);
+  bool obs_in_use(std::uint32_t e) const { return e < obs_fresh_ && obs_[e].owner != kNone; }
   void release_owner(std::uint32_t owner);
   void location_to_cell(std::uint32_t location, std::int32_t* ix, std::int32_t* iy) const;
 
@@ -386,8 +393,15 @@ class DpMap final : public TreeListener {
   std::uint32_t* tile_table_ = nullptr;  // tiles_x_ · tiles_y_ entries: tile slot or kNone
   ArenaPool<Tile> tiles_pool_;
   Tile* tiles_ = nullptr;  // slot 0 of tiles_pool_ (slots are contiguous)
-  ArenaPool<Observation> obs_pool_;
-  Observation* obs_ = nullptr;  // slot 0 of obs_pool_
+  // Observation slots: obs_capacity_ of them, obs_used_ in use. Slots from obs_fresh_ on
+  // were never handed out; the others that are free (owner kNone) form a stack through
+  // next_in_node from obs_free_ (kNone when empty).
+  Observation* obs_ = nullptr;
+  std::uint32_t obs_capacity_ = 0U;
+  std::uint32_t obs_fresh_ = 0U;
+  std::uint32_t obs_used_ = 0U;
+  std::uint32_t obs_peak_ = 0U;
+  std::uint32_t obs_free_ = kNone;
   // Owner tables, node_capacity_ entries each, one arena block. An owner is in use iff
   // it is not on the free stack; then owner_node_[o] is its node,
   // node_owner_[owner_node_[o]] == o, owner_head_[o] its first observation (never
