@@ -764,9 +764,7 @@ bool DpMap::invariants_hold() const {
 void DpMap::transfer_state(StateIo& io) {
   io.section("dp_map");
   tiles_pool_.transfer_state(io);
-  std::uint32_t obs_capacity = obs_capacity_;
-  io.value(obs_capacity);
-  if (io.ok() && obs_capacity != obs_capacity_) io.fail("dp map observation capacity differs", nullptr);
+  io.fixed(obs_capacity_, "dp map observation capacity");
   io.value(obs_fresh_);
   io.value(obs_used_);
   io.value(obs_peak_);

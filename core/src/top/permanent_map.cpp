@@ -240,9 +240,7 @@ PermanentMap::Cell PermanentMap::cell(std::int32_t ix, std::int32_t iy) const {
 
 void PermanentMap::transfer_state(StateIo& io) {
   io.section("permanent_map");
-  std::uint32_t capacity = tile_capacity_;
-  io.value(capacity);
-  if (io.ok() && capacity != tile_capacity_) io.fail("permanent map capacity differs", nullptr);
+  io.fixed(tile_capacity_, "permanent map capacity");
   io.value(tiles_used_);
   io.value(table_mask_);
   io.value(table_shift_);

@@ -111,9 +111,7 @@ class IPool {
   // Snapshot of the bookkeeping (state_io.h). The slots, free links and generations are
   // the storage's: an ArenaPool's travel with the arena.
   void transfer_state(StateIo& io) {
-    std::uint32_t capacity = capacity_;
-    io.value(capacity);
-    if (io.ok() && capacity != capacity_) io.fail("pool capacity differs", nullptr);
+    io.fixed(capacity_, "pool capacity");
     io.value(size_);
     io.value(free_head_);
     io.value(peak_used_);

@@ -96,6 +96,14 @@ class StateIo {
       p = reinterpret_cast<T*>(base_ + off);
     }
   }
+  // A value init() fixed (a capacity): written, or read and compared with this
+  // engine's; a stream whose value differs fails, naming `what`.
+  template <class T>
+  void fixed(const T& v, const char* what) {
+    T theirs = v;
+    value(theirs);
+    if (ok() && !(theirs == v)) fail(what, "differs from this engine's");
+  }
   // A part's name (up to 15 characters): written, or read and compared.
   void section(const char* name);
   void fail(const char* reason, const char* what);
