@@ -1,12 +1,11 @@
 #include <CppUTest/TestHarness.h>
 
 #include <cstdint>
-#include <cstring>
-#include <vector>
 
 #include "sdpslam/core/arena.h"
 #include "sdpslam/core/pool.h"
 #include "sdpslam/core/state_io.h"
+#include "memory_state.h"
 
 namespace {
 
@@ -27,22 +26,6 @@ struct Rng {
     s ^= s >> 7U;
     s ^= s << 17U;
     return static_cast<std::uint32_t>(s >> 32U);
-  }
-};
-
-struct Bytes final : sdpslam::StateWriter, sdpslam::StateReader {
-  std::vector<unsigned char> data;
-  std::size_t at = 0U;
-  bool write(const void* p, std::size_t n) override {
-    const auto* c = static_cast<const unsigned char*>(p);
-    data.insert(data.end(), c, c + n);
-    return true;
-  }
-  bool read(void* p, std::size_t n) override {
-    if (n > data.size() - at) return false;
-    std::memcpy(p, data.data() + at, n);
-    at += n;
-    return true;
   }
 };
 
@@ -253,23 +236,24 @@ TEST(Pool, a_snapshot_loads_only_into_a_pool_of_the_same_capacity) {
   sdpslam::Pool<Node, 4> saved;  // small: on the stack
   CHECK(saved.create(1) != nullptr);
   CHECK(saved.create(2) != nullptr);
-  Bytes bytes;
-  sdpslam::StateIo out(static_cast<sdpslam::StateWriter&>(bytes), nullptr, 0U);
+  sdpslam::test::MemoryWriter bytes;
+  sdpslam::StateIo out(bytes, nullptr, 0U);
   saved.transfer_state(out);
   CHECK_TRUE(out.ok());
 
   sdpslam::Pool<Node, 5> other;
-  sdpslam::StateIo refused(static_cast<sdpslam::StateReader&>(bytes), nullptr, 0U);
+  sdpslam::test::MemoryReader first(bytes.bytes_);
+  sdpslam::StateIo refused(first, nullptr, 0U);
   other.transfer_state(refused);
   CHECK_FALSE(refused.ok());
   STRCMP_EQUAL("pool capacity: differs from this engine's", refused.why());
   LONGS_EQUAL(0, other.size());
 
-  bytes.at = 0U;
   // Only the bookkeeping travels (a Pool's slots are its own; an ArenaPool's travel
   // with the arena): the counters come back.
   sdpslam::Pool<Node, 4> same;
-  sdpslam::StateIo loaded(static_cast<sdpslam::StateReader&>(bytes), nullptr, 0U);
+  sdpslam::test::MemoryReader second(bytes.bytes_);
+  sdpslam::StateIo loaded(second, nullptr, 0U);
   same.transfer_state(loaded);
   CHECK_TRUE(loaded.ok());
   LONGS_EQUAL(2, same.size());

@@ -7,37 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "memory_state.h"
 #include "sdp_harness.h"
 #include "top/segment_graph.h"
 
 using namespace sdpslam;
+using sdpslam::test::MemoryReader;
+using sdpslam::test::MemoryWriter;
 
 namespace {
-
-class MemoryWriter final : public StateWriter {
- public:
-  bool write(const void* data, std::size_t bytes) override {
-    const auto* p = static_cast<const unsigned char*>(data);
-    bytes_.insert(bytes_.end(), p, p + bytes);
-    return true;
-  }
-  std::vector<unsigned char> bytes_;
-};
-
-class MemoryReader final : public StateReader {
- public:
-  explicit MemoryReader(const std::vector<unsigned char>& bytes) : bytes_(bytes) {}
-  bool read(void* data, std::size_t bytes) override {
-    if (bytes > bytes_.size() - at_) return false;
-    std::memcpy(data, bytes_.data() + at_, bytes);
-    at_ += bytes;
-    return true;
-  }
-  std::size_t at_ = 0U;
-
- private:
-  const std::vector<unsigned char>& bytes_;
-};
 
 // The product's configuration on the test room: loop closure and the wide loop search on,
 // so that every part of the engine holds state across scans.
