@@ -99,6 +99,21 @@ TEST(CliEvaluate, paths_with_quotes_and_backslashes_read_back_from_the_json) {
   CHECK_TRUE(j["ate"]["rmse_m"].is_number_float());
 }
 
+// The worst relation is named with its stamps, in the text and in the JSON.
+TEST(CliEvaluate, the_worst_relation_is_named_with_its_stamps) {
+  const std::string json = dir + "/out.json";
+  const std::string t = put("t.txt", "10.000000 0 0 0\n11.000000 1 0 0\n12.000000 2.5 0 0\n");
+  const Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  // Both relations lie within a minute of each other: one event, the 0.5 m one.
+  STRCMP_CONTAINS("worst       stamps 11.0 s and 12.0 s (1.00 m apart): 0.500 m, 0.00 deg off", r.out.c_str());
+  CHECK(r.out.find("stamps 10.0 s") == std::string::npos);
+  const nlohmann::json w = json_of(json)["relations"]["worst"];
+  LONGS_EQUAL(1, w.size());
+  LONGS_EQUAL(11000000, w[0]["t1_us"].get<long>());
+  DOUBLES_EQUAL(0.5, w[0]["translation_m"].get<double>(), 1e-9);
+}
+
 TEST(CliEvaluate, sparse_trajectory_is_filled_with_odometry) {
   // Only the first scan estimated: the rest comes from odometry, so figures equal the
   // odometry's.

@@ -129,6 +129,46 @@ TEST(Relations, unmatched_list_is_bounded) {
   LONGS_EQUAL(0, res.translation_m.count);
 }
 
+// The worst relations name where a run went wrong: worst first, one per event (a
+// stretch and its revisit err alike over many relations), at most as many as asked.
+TEST(Relations, worst_relations_name_one_relation_per_event_worst_first) {
+  const auto gt = truth(400);  // 40 s
+  // Relations from three stretches to three later ones (events A, B, C), several each.
+  std::vector<Relation> rel;
+  const auto add = [&](std::size_t i, std::size_t j) {
+    rel.push_back(Relation{gt[i].stamp_us, gt[j].stamp_us, sdpslam::between(gt[i].pose, gt[j].pose),
+                           static_cast<std::int64_t>(rel.size() + 1)});
+  };
+  for (std::size_t k = 0; k < 3; ++k) add(10 + k, 300 + k);  // A
+  for (std::size_t k = 0; k < 3; ++k) add(100 + k, 350 + k);  // B
+  for (std::size_t k = 0; k < 3; ++k) add(200 + k, 390 + k);  // C
+  // The estimate: the truth with the revisits of B shifted 3 m and those of A 1 m.
+  std::vector<StampedPose> est = gt;
+  const auto shift = [&](std::size_t first, double dx_m) {
+    for (std::size_t i = first; i < first + 3; ++i) est[i].pose.x_m += dx_m;
+  };
+  shift(300, 1.0);
+  shift(350, 3.0);
+  const auto res = sdpslam::eval::evaluate_relations(rel, est);
+  LONGS_EQUAL(9, res.used_count);
+  // Events apart by more than 2 s: B (3 m), then A (1 m), then C (0 m).
+  const auto worst = sdpslam::eval::worst_relations(res, 5, 2000000);
+  LONGS_EQUAL(3, worst.size());
+  // Each event's relations err alike (to rounding): which of them stands for it is open.
+  const auto in_event = [&](std::size_t w, std::size_t first) {
+    const std::int64_t t1 = res.per_relation[w].relation.t1_us;
+    return t1 >= gt[first].stamp_us && t1 <= gt[first + 2].stamp_us;
+  };
+  CHECK_TRUE(in_event(worst[0], 100));
+  DOUBLES_EQUAL(3.0, res.per_relation[worst[0]].translation_error_m, 1e-9);
+  CHECK_TRUE(in_event(worst[1], 10));
+  DOUBLES_EQUAL(1.0, res.per_relation[worst[1]].translation_error_m, 1e-9);
+  CHECK_TRUE(in_event(worst[2], 200));
+  // At most as many as asked; with events taken as 0.1 s apart, every relation is one.
+  LONGS_EQUAL(2, sdpslam::eval::worst_relations(res, 2, 2000000).size());
+  LONGS_EQUAL(9, sdpslam::eval::worst_relations(res, 20, 0).size());
+}
+
 TEST_GROUP(FillWithOdometry){};
 
 TEST(FillWithOdometry, missing_scans_are_last_estimate_composed_with_odometry) {

@@ -24,6 +24,7 @@
 // Exit codes (cli_common.h): bad or inconsistent input → kExitBadInput with file:line.
 #include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -192,6 +193,23 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
   row("translation^2 [m^2]", res.translation_m2);
   row("rotation [deg]", res.rotation_deg);
   row("rotation^2 [deg^2]", res.rotation_deg2);
+  // Where it went wrong, worst first, one relation per event (a stretch and a revisit
+  // of it err alike over many relations): the stamps to look at in the log.
+  constexpr std::size_t kWorstShown = 5U;
+  constexpr std::int64_t kSameEventUs = 60000000;
+  io::Json worst = io::Json::array();
+  for (std::size_t i : eval::worst_relations(res, kWorstShown, kSameEventUs)) {
+    const eval::RelationResult& w = res.per_relation[i];
+    const double apart_m = std::hypot(w.relation.expected.x_m, w.relation.expected.y_m);
+    std::printf("  worst       stamps %.1f s and %.1f s (%.2f m apart): %.3f m, %.2f deg off\n",
+                static_cast<double>(w.relation.t1_us) * 1e-6, static_cast<double>(w.relation.t2_us) * 1e-6, apart_m,
+                w.translation_error_m, w.rotation_error_rad * kRadToDeg);
+    worst.push_back(io::Json{{"t1_us", w.relation.t1_us},
+                             {"t2_us", w.relation.t2_us},
+                             {"apart_m", apart_m},
+                             {"translation_m", w.translation_error_m},
+                             {"rotation_deg", w.rotation_error_rad * kRadToDeg}});
+  }
 
   (*json)["relations"] = {{"file", a.relations_path},
                           {"log", a.log_path},
@@ -206,7 +224,8 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                           {"translation_m", json_stats(res.translation_m)},
                           {"translation_m2", json_stats(res.translation_m2)},
                           {"rotation_deg", json_stats(res.rotation_deg)},
-                          {"rotation_deg2", json_stats(res.rotation_deg2)}};
+                          {"rotation_deg2", json_stats(res.rotation_deg2)},
+                          {"worst", worst}};
   if (res.used_count == 0) {
     std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
                  a.log_path.c_str());

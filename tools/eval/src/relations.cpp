@@ -1,6 +1,7 @@
 // Relations metric (see relations.h).
 #include "sdpslam/eval/relations.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -173,6 +174,27 @@ RelationsResult evaluate_relations(const std::vector<Relation>& relations, const
   res.rotation_deg = summarize(r_abs);
   res.rotation_deg2 = summarize(r_sq);
   return res;
+}
+
+std::vector<std::size_t> worst_relations(const RelationsResult& result, std::size_t count, std::int64_t apart_us) {
+  std::vector<std::size_t> order(result.per_relation.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&result](std::size_t a, std::size_t b) {
+    return result.per_relation[a].translation_error_m > result.per_relation[b].translation_error_m;
+  });
+  const auto near = [apart_us](std::int64_t a, std::int64_t b) { return (a > b ? a - b : b - a) <= apart_us; };
+  std::vector<std::size_t> chosen;
+  for (std::size_t i : order) {
+    if (chosen.size() >= count) break;
+    const Relation& r = result.per_relation[i].relation;
+    bool same_event = false;
+    for (std::size_t j : chosen) {
+      const Relation& q = result.per_relation[j].relation;
+      same_event = same_event || (near(r.t1_us, q.t1_us) && near(r.t2_us, q.t2_us));
+    }
+    if (!same_event) chosen.push_back(i);
+  }
+  return chosen;
 }
 
 }  // namespace sdpslam::eval

@@ -84,4 +84,11 @@ struct RelationsResult {
 RelationsResult evaluate_relations(const std::vector<Relation>& relations, const std::vector<io::StampedPose>& per_scan,
                                    std::int64_t tolerance_us = kDefaultStampToleranceUs);
 
+// Where a trajectory went wrong: the used relations with the largest translational
+// errors, worst first, at most `count`, one per event. A relation is left out when both
+// its stamps lie within `apart_us` of the stamps of one already chosen: the relations
+// between one stretch and one revisit of it err alike, and would hide the next event.
+// Indices into result.per_relation; ties keep file order.
+std::vector<std::size_t> worst_relations(const RelationsResult& result, std::size_t count, std::int64_t apart_us);
+
 }  // namespace sdpslam::eval
