@@ -381,7 +381,8 @@ SdpStepResult SdpSlamImpl::process(const OdometrySample& odom, const RangeScan& 
       // scan as new observations before prune folds them into its lineage): the segment
       // ends, and make_room() frees older levels.
       const DpMap& map = filter_->map();
-      if (std::uint64_t{map.observation_capacity() - map.observations_used()} < scan_burst()) end = SegmentEnd::kPool;
+      const std::uint64_t held = std::uint64_t{map.observations_used()} - deferred_observations();
+      if (std::uint64_t{map.observation_capacity()} - held < scan_burst()) end = SegmentEnd::kPool;
     }
     if (end != SegmentEnd::kNone) {
       const std::uint64_t before = stats_.segments;
@@ -394,6 +395,7 @@ SdpStepResult SdpSlamImpl::process(const OdometrySample& odom, const RangeScan& 
       }
     }
   }
+  deferred_release_step();
   // Top-level work within the budget: anchorage first (the evaluation needs skeletons).
   // With defer_top_work it waits while the bottom level processes scans (bounded).
   if (options_.defer_top_work && result.bottom.status == StepResult::Status::kProcessed &&
@@ -428,6 +430,8 @@ SdpStepResult SdpSlamImpl::process(const OdometrySample& odom, const RangeScan& 
 
 void SdpSlamImpl::finish() {
   if (!initialised_) return;
+  finish_releases();
+  releases_deferred_ = false;
   while (do_work(0xFFFFFFFFU) > 0U) {
   }
 }
@@ -545,20 +549,71 @@ std::uint64_t SdpSlamImpl::observations_needed() const {
   return grown + (map.observation_oom_count() - segment_observations_refused_) + scan_burst() + later;
 }
 
+// The levels that go are decided on the room as it will be once their releases and map
+// copies are done; the releases and copy of the last of them are deferred: they give
+// their observations back over the next scans, one submap (or one slice of the copy)
+// per scan, outside do_work()'s budget, so that the scan of a segmentation does not pay
+// for a whole level. Until then that room counts as made wherever the pool's room is
+// judged (here, the segment's pool check in process()), and a scan whose writes need it
+// now takes it at once (make_room_now()). Which levels go, and when, is the same as if
+// every release were done at once.
 void SdpSlamImpl::make_room(std::uint64_t need) {
   const DpMap& map = filter_->map();
+  const std::uint64_t capacity = map.observation_capacity();
+  if (std::uint64_t{map.observations_used()} - deferred_observations() + need <= capacity) return;
+  defer_pending_releases();
   auto short_of_room = [&] {
-    return std::uint64_t{map.observations_used()} + need > std::uint64_t{map.observation_capacity()};
+    return std::uint64_t{map.observations_used()} - pending_release_observations() + need > capacity;
   };
-  if (!short_of_room()) return;
-  finish_releases();
   while (short_of_room() && graph_.live_level_count() > 0U) {
     const std::uint64_t before = stats_.levels_made_permanent;
-    make_oldest_permanent();
+    make_oldest_permanent();  // completes the previous level's releases and copy first
     if (stats_.levels_made_permanent == before) return;
-    finish_releases();
+    defer_pending_releases();
     ++stats_.levels_made_permanent_for_room;
   }
+}
+
+// The deferred releases first, one submap at a time, then the map copy, until the
+// writes fit; if they do not, the room a segmentation would make, taken now.
+void SdpSlamImpl::make_room_now(std::uint64_t need) {
+  const DpMap& map = filter_->map();
+  auto fits = [&] { return std::uint64_t{map.observations_used()} + need <= std::uint64_t{map.observation_capacity()}; };
+  while (releases_deferred_ && !fits() && release_count_ > 0U) release_one();
+  while (releases_deferred_ && !fits() && transfer_.active()) transfer_step(0xFFFFFFFFU);
+  if (releases_deferred_ && release_count_ == 0U && !transfer_.active()) releases_deferred_ = false;
+  if (fits()) return;
+  make_room(need);
+  finish_releases();
+}
+
+// A permanent level's tree goes whole: its other submaps are released (prune frees
+// their lineages and folds the rest into the chosen one), and the chosen submap is
+// copied into the global map and released. One level's work is pending at a time (the
+// next one completes it first), so its tree is the queue's and the copy's.
+std::uint64_t SdpSlamImpl::pending_release_observations() const {
+  NodeId node = kNoNode;
+  CellRect rest;
+  if (!transfer_.pending(&node, &rest) && release_count_ > 0U) node = release_queue_[0];
+  const AncestryTree& tree = filter_->tree();
+  if (node == kNoNode || !tree.contains(node)) return 0U;
+  const std::uint32_t sequence = tree.tree_sequence_unchecked(node);
+  const DpMap& map = filter_->map();
+  std::uint64_t held = 0U;
+  for (NodeId n = 0U; n < tree.capacity(); ++n) {
+    if (tree.contains(n) && tree.tree_sequence_unchecked(n) == sequence) held += map.observation_count(n);
+  }
+  return held;
+}
+
+void SdpSlamImpl::deferred_release_step() {
+  if (!releases_deferred_) return;
+  if (release_count_ > 0U) {
+    release_one();
+  } else if (transfer_.active()) {
+    transfer_step(options_.work_cells_per_scan);
+  }
+  if (release_count_ == 0U && !transfer_.active()) releases_deferred_ = false;
 }
 
 std::uint64_t SdpSlamImpl::scan_burst() const {
@@ -576,6 +631,7 @@ void SdpSlamImpl::make_oldest_permanent() {
   if (!graph_.is_live(level)) return;
   // Pending work first (the previous level's releases and transfer, this level's skeletons).
   finish_releases();
+  releases_deferred_ = false;
   const std::uint32_t count = store_.level(level).count;
   for (std::uint32_t k = 0; k < count; ++k) {
     if (!store_.submap(level, k).skeleton_done) extract_skeleton(level, k);
@@ -633,13 +689,17 @@ std::uint32_t SdpSlamImpl::release_one() {
 }
 
 std::uint32_t SdpSlamImpl::do_work(std::uint32_t budget_cells) {
-  std::uint32_t used = release_one();
+  // Deferred releases and copy have their own slice per scan (deferred_release_step()).
+  const bool own_releases = !releases_deferred_;
+  std::uint32_t used = own_releases ? release_one() : 0U;
   // The permanent submap's copy into the global map first, in strips within the budget:
   // its observations (and the tiles only it holds) are freed when it completes, and the
   // pool is what the bottom level's new observations come from.
   // It waits for the releases (one per call): they let prune fold the submap's lineage
   // into its node, which can then be popped.
-  if (transfer_.active() && release_count_ == 0U && used < budget_cells) used += transfer_step(budget_cells - used);
+  if (own_releases && transfer_.active() && release_count_ == 0U && used < budget_cells) {
+    used += transfer_step(budget_cells - used);
+  }
   if (used >= budget_cells) return used;
   // Skeletons of the live levels, oldest first, in slices.
   if (skeletons_.active()) used += skeleton_step(budget_cells - used);

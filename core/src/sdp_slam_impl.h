@@ -109,6 +109,16 @@ class SdpSlamImpl {
   void segment(std::int64_t stamp_us);
   std::uint64_t observations_needed() const;
   void make_room(std::uint64_t need);
+  // Room for writes about to be made (MapRoom): what make_room() does, with the room
+  // there now.
+  void make_room_now(std::uint64_t need);
+  // Observations the pending releases and map copy will give back.
+  std::uint64_t pending_release_observations() const;
+  // Of them, those make_room() deferred: room counted as made.
+  std::uint64_t deferred_observations() const { return releases_deferred_ ? pending_release_observations() : 0U; }
+  void defer_pending_releases() { releases_deferred_ = release_count_ > 0U || transfer_.active(); }
+  // One slice of the deferred releases and map copy (once per process()).
+  void deferred_release_step();
   // The most DP map observations one processed scan asked for, in this segment or the previous one.
   std::uint64_t scan_burst() const;
   void finish_releases();
@@ -170,7 +180,7 @@ class SdpSlamImpl {
   class RoomForWrites final : public MapRoom {
    public:
     explicit RoomForWrites(SdpSlamImpl& owner) : owner_(owner) {}
-    void make_room(std::uint64_t observations) override { owner_.make_room(observations); }
+    void make_room(std::uint64_t observations) override { owner_.make_room_now(observations); }
 
    private:
     SdpSlamImpl& owner_;
@@ -229,6 +239,9 @@ class SdpSlamImpl {
   double seg_box_[4] = {0.0, 0.0, 0.0, 0.0};  // best poses of the current segment
   // Top-level round.
   bool round_active_ = false;
+  // The pending releases and map copy are make_room()'s: they give their room back over
+  // the next scans (deferred_release_step()), outside do_work()'s budget.
+  bool releases_deferred_ = false;
   std::uint32_t deferred_in_a_row_ = 0U;  // defer_top_work: processed scans without top-level work
   std::uint32_t eval_cursor_ = 0U;
   std::uint32_t rounds_in_segment_ = 0U;

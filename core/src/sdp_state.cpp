@@ -148,6 +148,7 @@ void SdpSlamImpl::transfer_state(StateIo& io) {
   ring_.transfer_state(io);
   loop_closure_.transfer_state(io);
   io.value(release_count_);
+  io.value(releases_deferred_);
   transfer_.transfer_state(io);
   permanent_map_.transfer_state(io);
   io.section("segment");

@@ -688,6 +688,45 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
   CHECK(t.poses.size() > 100U);
 }
 
+// With that short pool, a level made permanent for room at a segmentation gives its
+// observations back over the following scans, one submap per scan, instead of all in
+// the segmentation's scan: no call of process() releases more than one submap, except
+// one that makes several levels permanent (each completes the one before), one whose
+// writes need the room at once (it asks the pool for room), or one that ends a segment
+// at max_levels (that level's releases come out of do_work()'s budget, as always). The
+// levels chosen are the same as with every release done at once, which
+// tools/bench/accuracy.sh checks byte for byte on the logs and worlds.
+TEST(SdpSlam, a_level_made_permanent_for_room_is_released_over_the_next_scans) {
+  const test::ScanSet set(2);
+  SdpOptions s = test::small_sdp_options();
+  const std::uint32_t peak = pool_peak_with_room_to_spare(set, s);
+  s.map_observation_capacity = peak / 2U;
+  test::SdpRig rig;
+  CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+  std::uint64_t most_released = 0U;
+  std::uint64_t spread_calls = 0U;  // calls that released one submap of a deferred level
+  for (std::size_t i = 0; i < set.scans.size(); ++i) {
+    const SdpStats before = rig.slam->stats();
+    const std::uint64_t asked = rig.slam->bottom().stats().map_room_asked;
+    rig.slam->process(set.odom(i), *set.scans[i]);
+    const SdpStats& after = rig.slam->stats();
+    const std::uint64_t released = after.submaps_released - before.submaps_released;
+    const std::uint64_t made = after.levels_made_permanent - before.levels_made_permanent;
+    const std::uint64_t for_room = after.levels_made_permanent_for_room - before.levels_made_permanent_for_room;
+    if (made == 0U && released == 1U) ++spread_calls;
+    if (made > 1U || made > for_room || rig.slam->bottom().stats().map_room_asked != asked) continue;
+    if (released > most_released) most_released = released;
+  }
+  const SdpStats& st = rig.slam->stats();
+  CHECK(st.levels_made_permanent_for_room > 0U);
+  LONGS_EQUAL(1, most_released);
+  CHECK(spread_calls > 0U);
+  LONGS_EQUAL(0, rig.slam->bottom().map().observation_oom_count());
+  LONGS_EQUAL(0, rig.slam->bottom().stats().map_updates_dropped);
+  CHECK_TRUE(rig.slam->bottom().map().invariants_hold());
+  CHECK_TRUE(rig.slam->graph().invariants_hold());
+}
+
 // Whatever the pool's size between half of and all that the run's live levels hold at
 // their peak, every scan is written whole (no map update is refused, no write shortened):
 // a segment starts only with room for its restart (its first scan written whole into

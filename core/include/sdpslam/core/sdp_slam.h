@@ -47,9 +47,11 @@
 // call of process() so that no single scan pays for all of them. The DP map's
 // observation pool bounds the live levels too: a segment ends (SegmentEnd::kPool) when
 // the pool could not take another scan's writes, and at a segmentation older levels
-// become permanent early, released at once, until the next segment's expected need
-// fits (make_room(); counted as levels_made_permanent_for_room). A full pool would
-// instead refuse the current segment's own map updates.
+// become permanent early until the next segment's expected need fits (make_room();
+// counted as levels_made_permanent_for_room). The last of them gives its observations
+// back over the next scans, one submap per scan (its room counted as made meanwhile),
+// unless a scan's writes need them at once. A full pool would instead refuse the
+// current segment's own map updates.
 //
 // Loop closure (beyond the paper, SdpOptions::loop_closure; loop_closure.h): every
 // skeleton ICP match of two non-adjacent submaps is handed to LoopClosure::refine, which
