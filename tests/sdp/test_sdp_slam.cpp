@@ -663,6 +663,14 @@ std::uint32_t pool_peak_with_room_to_spare(const test::ScanSet& set, const SdpOp
   return map.observations_peak();
 }
 
+// A rig whose DP map's observation pool holds half of what the run's live levels hold
+// at their peak.
+void init_with_half_the_pool(const test::ScanSet& set, test::SdpRig* rig) {
+  SdpOptions s = test::small_sdp_options();
+  s.map_observation_capacity = pool_peak_with_room_to_spare(set, s) / 2U;
+  CHECK_TRUE(rig->init(test::sim_options(5), s, 5));
+}
+
 }  // namespace
 
 // The DP map's observation pool sized at half of what a run's live levels hold at their
@@ -670,11 +678,8 @@ std::uint32_t pool_peak_with_room_to_spare(const test::ScanSet& set, const SdpOp
 // take another scan) instead of the pool refusing the current segment's map updates.
 TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_refusing_updates) {
   const test::ScanSet set(2);
-  SdpOptions s = test::small_sdp_options();
-  const std::uint32_t peak = pool_peak_with_room_to_spare(set, s);
-  s.map_observation_capacity = peak / 2U;
   test::SdpRig rig;
-  CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+  init_with_half_the_pool(set, &rig);
   test::CollectPoses sink;
   const Trace t = run_sdp(rig, set, &sink);
   const SdpStats& st = rig.slam->stats();
@@ -698,11 +703,8 @@ TEST(SdpSlam, a_short_observation_pool_makes_levels_permanent_early_instead_of_r
 // tools/bench/accuracy.sh checks byte for byte on the logs and worlds.
 TEST(SdpSlam, a_level_made_permanent_for_room_is_released_over_the_next_scans) {
   const test::ScanSet set(2);
-  SdpOptions s = test::small_sdp_options();
-  const std::uint32_t peak = pool_peak_with_room_to_spare(set, s);
-  s.map_observation_capacity = peak / 2U;
   test::SdpRig rig;
-  CHECK_TRUE(rig.init(test::sim_options(5), s, 5));
+  init_with_half_the_pool(set, &rig);
   std::uint64_t most_released = 0U;
   std::uint64_t spread_calls = 0U;  // calls that released one submap of a deferred level
   for (std::size_t i = 0; i < set.scans.size(); ++i) {
