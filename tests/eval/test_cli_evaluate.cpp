@@ -112,6 +112,15 @@ TEST(CliEvaluate, the_worst_relation_is_named_with_its_stamps) {
   LONGS_EQUAL(1, w.size());
   LONGS_EQUAL(11000000, w[0]["t1_us"].get<long>());
   DOUBLES_EQUAL(0.5, w[0]["translation_m"].get<double>(), 1e-9);
+  // Both relations span 1 s: the local class holds them and all the error.
+  STRCMP_CONTAINS("span        under 2 s: 2 relations, mean 0.250 m, max 0.500 m (100 % of the error)", r.out.c_str());
+  STRCMP_CONTAINS("span        60 s and over: 0 relations", r.out.c_str());
+  const nlohmann::json s = json_of(json)["relations"]["by_span"];
+  LONGS_EQUAL(3, s.size());
+  LONGS_EQUAL(2, s[0]["count"].get<long>());
+  DOUBLES_EQUAL(2.0, s[0]["to_s"].get<double>(), 0.0);
+  DOUBLES_EQUAL(1.0, s[0]["share"].get<double>(), 1e-9);
+  CHECK_TRUE(s[2]["to_s"].is_null());
 }
 
 TEST(CliEvaluate, sparse_trajectory_is_filled_with_odometry) {

@@ -169,6 +169,58 @@ TEST(Relations, worst_relations_name_one_relation_per_event_worst_first) {
   LONGS_EQUAL(9, sdpslam::eval::worst_relations(res, 20, 0).size());
 }
 
+TEST(Relations, relations_by_span_split_the_error_into_local_steps_and_revisits) {
+  const auto gt = truth(1000);  // 100 s, a pose every 0.1 s
+  std::vector<Relation> rel;
+  const auto add = [&](std::size_t i, std::size_t j) {
+    rel.push_back(Relation{gt[i].stamp_us, gt[j].stamp_us, sdpslam::between(gt[i].pose, gt[j].pose),
+                           static_cast<std::int64_t>(rel.size() + 1)});
+  };
+  // Spans 1 s (4 relations), exactly 2 s (1: the edge belongs to the next class),
+  // 10 s (1), exactly 60 s (1) and 90 s (2).
+  for (std::size_t k = 0; k < 4; ++k) add(100 + k, 110 + k);
+  add(200, 220);
+  add(300, 400);
+  add(0, 600);
+  add(5, 905);
+  add(6, 906);
+  // The estimate: the truth with poses 906 and after 1 m off, so only the last 90 s
+  // relation errs (1 m), and pose 110 0.2 m off, so one 1 s relation errs (0.2 m).
+  std::vector<StampedPose> est = gt;
+  for (std::size_t i = 906; i < est.size(); ++i) est[i].pose.y_m += 1.0;
+  est[110].pose.y_m += 0.2;
+  const auto res = sdpslam::eval::evaluate_relations(rel, est);
+  LONGS_EQUAL(9, res.used_count);
+  const auto c = sdpslam::eval::relations_by_span(res, {2000000, 60000000});
+  LONGS_EQUAL(3, c.size());
+  LONGS_EQUAL(0, c[0].from_us);
+  LONGS_EQUAL(2000000, c[0].to_us);
+  LONGS_EQUAL(4, c[0].translation_m.count);
+  DOUBLES_EQUAL(0.05, c[0].translation_m.mean, 1e-9);
+  DOUBLES_EQUAL(0.2, c[0].translation_m.max, 1e-9);
+  LONGS_EQUAL(2000000, c[1].from_us);
+  LONGS_EQUAL(60000000, c[1].to_us);
+  LONGS_EQUAL(2, c[1].translation_m.count);
+  DOUBLES_EQUAL(0.0, c[1].translation_m.mean, 1e-9);
+  LONGS_EQUAL(60000000, c[2].from_us);
+  LONGS_EQUAL(-1, c[2].to_us);
+  LONGS_EQUAL(3, c[2].translation_m.count);
+  DOUBLES_EQUAL(1.0 / 3.0, c[2].translation_m.mean, 1e-9);
+  // Shares of the 1.2 m of error in all.
+  DOUBLES_EQUAL(0.2 / 1.2, c[0].share, 1e-9);
+  DOUBLES_EQUAL(0.0, c[1].share, 1e-9);
+  DOUBLES_EQUAL(1.0 / 1.2, c[2].share, 1e-9);
+  // No edges: one class with everything; no relations: empty classes, no shares.
+  const auto one = sdpslam::eval::relations_by_span(res, {});
+  LONGS_EQUAL(1, one.size());
+  LONGS_EQUAL(9, one[0].translation_m.count);
+  DOUBLES_EQUAL(1.0, one[0].share, 1e-9);
+  const auto none = sdpslam::eval::relations_by_span(sdpslam::eval::RelationsResult{}, {2000000});
+  LONGS_EQUAL(2, none.size());
+  LONGS_EQUAL(0, none[0].translation_m.count + none[1].translation_m.count);
+  DOUBLES_EQUAL(0.0, none[0].share + none[1].share, 0.0);
+}
+
 TEST_GROUP(FillWithOdometry){};
 
 TEST(FillWithOdometry, missing_scans_are_last_estimate_composed_with_odometry) {

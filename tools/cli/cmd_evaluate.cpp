@@ -51,6 +51,13 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
+// "2 s", "60 s", "0.5 s": seconds as a person writes them.
+std::string format_seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", s);
+  return text;
+}
+
 struct EvaluateArgs {
   std::string log_path;
   std::string relations_path;
@@ -211,6 +218,26 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                              {"rotation_deg", w.rotation_error_rad * kRadToDeg}});
   }
 
+  // Local error or revisits: relations between scans under 2 s apart measure the step
+  // by step error (the same split with --odometry gives the odometry's); a minute and
+  // more, as for the worst events, the revisits.
+  io::Json by_span = io::Json::array();
+  for (const eval::SpanClass& c : eval::relations_by_span(res, {2000000, kSameEventUs})) {
+    const double from_s = static_cast<double>(c.from_us) * 1e-6;
+    const double to_s = static_cast<double>(c.to_us) * 1e-6;
+    std::string range = c.to_us < 0 ? format_seconds(from_s) + " and over"
+                        : c.from_us == 0 ? "under " + format_seconds(to_s)
+                                         : format_seconds(from_s) + " to " + format_seconds(to_s);
+    std::printf("  span        %s: %zu relations, mean %.3f m, max %.3f m (%.0f %% of the error)\n", range.c_str(),
+                c.translation_m.count, c.translation_m.mean, c.translation_m.max, 100.0 * c.share);
+    by_span.push_back(io::Json{{"from_s", from_s},
+                               {"to_s", c.to_us < 0 ? io::Json(nullptr) : io::Json(to_s)},
+                               {"count", c.translation_m.count},
+                               {"translation_mean_m", c.translation_m.mean},
+                               {"translation_max_m", c.translation_m.max},
+                               {"share", c.share}});
+  }
+
   (*json)["relations"] = {{"file", a.relations_path},
                           {"log", a.log_path},
                           {"trajectory", a.odometry ? std::string("odometry") : a.trajectory_path},
@@ -225,7 +252,8 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                           {"translation_m2", json_stats(res.translation_m2)},
                           {"rotation_deg", json_stats(res.rotation_deg)},
                           {"rotation_deg2", json_stats(res.rotation_deg2)},
-                          {"worst", worst}};
+                          {"worst", worst},
+                          {"by_span", by_span}};
   if (res.used_count == 0) {
     std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
                  a.log_path.c_str());

@@ -197,4 +197,27 @@ std::vector<std::size_t> worst_relations(const RelationsResult& result, std::siz
   return chosen;
 }
 
+std::vector<SpanClass> relations_by_span(const RelationsResult& result, const std::vector<std::int64_t>& edges_us) {
+  std::vector<std::vector<double>> errors(edges_us.size() + 1U);
+  double total = 0.0;
+  for (const RelationResult& r : result.per_relation) {
+    const std::int64_t span = r.relation.t2_us > r.relation.t1_us ? r.relation.t2_us - r.relation.t1_us
+                                                                   : r.relation.t1_us - r.relation.t2_us;
+    std::size_t k = 0;
+    while (k < edges_us.size() && span >= edges_us[k]) ++k;
+    errors[k].push_back(r.translation_error_m);
+    total += r.translation_error_m;
+  }
+  std::vector<SpanClass> out(errors.size());
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    out[k].from_us = k == 0 ? 0 : edges_us[k - 1];
+    out[k].to_us = k < edges_us.size() ? edges_us[k] : -1;
+    out[k].translation_m = summarize(errors[k]);
+    double sum = 0.0;
+    for (double e : errors[k]) sum += e;
+    out[k].share = total > 0.0 ? sum / total : 0.0;
+  }
+  return out;
+}
+
 }  // namespace sdpslam::eval

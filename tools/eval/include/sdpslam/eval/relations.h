@@ -91,4 +91,19 @@ RelationsResult evaluate_relations(const std::vector<Relation>& relations, const
 // Indices into result.per_relation; ties keep file order.
 std::vector<std::size_t> worst_relations(const RelationsResult& result, std::size_t count, std::int64_t apart_us);
 
+// Local error or revisits: the used relations split by their span |t2 − t1|. A log's
+// relations mix pairs of nearby scans (what the odometry and the scan matching get
+// right or wrong step by step) with pairs of a place and its revisit (what the loops get
+// right or wrong); the overall mean hides which of the two a run loses. Class k holds
+// the spans in [edges_us[k − 1], edges_us[k]) (edges ascending; class 0 from 0, the last
+// to no end): edges.size() + 1 classes, each with its translational error and its share
+// of the sum of all used relations' translational errors (0 when that sum is 0).
+struct SpanClass {
+  std::int64_t from_us = 0;
+  std::int64_t to_us = -1;  // -1: no upper end
+  ErrorStats translation_m;
+  double share = 0.0;
+};
+std::vector<SpanClass> relations_by_span(const RelationsResult& result, const std::vector<std::int64_t>& edges_us);
+
 }  // namespace sdpslam::eval
