@@ -61,7 +61,7 @@ bool SdpSession::feed(const OdometrySample& odom_in, const RangeScan& scan_in, S
 }
 
 std::vector<io::StampedPose> SdpSession::trajectory(std::uint64_t* gaps) const {
-  return assemble_trajectory(scans_, sdp_best_path(*slam_, permanent_), gaps);
+  return smooth_with_odometry(scans_, assemble_trajectory(scans_, sdp_best_path(*slam_, permanent_), gaps));
 }
 
 std::uint32_t SdpSession::map_image(io::OccupancyImage* image) const { return sdp_global_map_image(*slam_, image); }

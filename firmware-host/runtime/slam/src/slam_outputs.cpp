@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "sdpslam/core/det_math.h"
+
 namespace sdpslam::slam {
 
 std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& scans,
@@ -40,6 +42,47 @@ std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& 
   }
   if (path_gaps != nullptr) *path_gaps = gaps;
   return trajectory;
+}
+
+std::vector<io::StampedPose> smooth_with_odometry(const std::vector<ScanRecord>& scans,
+                                                  const std::vector<io::StampedPose>& trajectory) {
+  const std::size_t n = trajectory.size();
+  if (scans.size() != n) return trajectory;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (scans[i].stamp_us != trajectory[i].stamp_us) return trajectory;
+  }
+  // Travel along the trajectory up to each pose.
+  std::vector<double> travel(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) {
+    const Pose2 d = between(trajectory[i - 1].pose, trajectory[i].pose);
+    travel[i] = travel[i - 1] + det::sqrt(d.x_m * d.x_m + d.y_m * d.y_m) + kSmoothTurnM * std::fabs(d.heading_rad);
+  }
+  const double reach = 2.0 * kSmoothSigmaM;
+  std::vector<io::StampedPose> out = trajectory;
+  std::size_t lo = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    while (travel[i] - travel[lo] > reach) ++lo;
+    const Pose2& own = trajectory[i].pose;
+    double sx = 0.0, sy = 0.0, sc = 0.0, ss = 0.0, sw = 0.0;
+    for (std::size_t j = lo; j < n && travel[j] - travel[i] <= reach; ++j) {
+      const Pose2 p = trajectory[j].pose.compose(between(scans[j].odom, scans[i].odom));
+      const double ex = p.x_m - own.x_m;
+      const double ey = p.y_m - own.y_m;
+      if (ex * ex + ey * ey > kSmoothGateM * kSmoothGateM) continue;
+      const double u = (travel[j] - travel[i]) / kSmoothSigmaM;
+      const double w = det::exp(-0.5 * u * u);
+      // Positions relative to p_i, headings as their difference to p_i's: no wrap.
+      const double dh = normalize_angle_rad(p.heading_rad - own.heading_rad);
+      sx += w * ex;
+      sy += w * ey;
+      sc += w * det::cos(dh);
+      ss += w * det::sin(dh);
+      sw += w;
+    }
+    if (!(sw > 0.0)) continue;  // p_i itself always counts; cannot happen
+    out[i].pose = Pose2{own.x_m + sx / sw, own.y_m + sy / sw, normalize_angle_rad(own.heading_rad + det::atan2(ss, sc))};
+  }
+  return out;
 }
 
 std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* image) {

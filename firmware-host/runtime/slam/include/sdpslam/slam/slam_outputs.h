@@ -43,6 +43,24 @@ std::vector<io::StampedPose> assemble_trajectory(const std::vector<ScanRecord>& 
                                                  const std::vector<io::StampedPose>& best_path,
                                                  std::uint64_t* path_gaps);
 
+// The trajectory smoothed with the odometry. A processed scan's pose carries the scan
+// match's own error and the proposal's sample noise (core/dpslam_options.h): centimetres
+// and tenths of a degree that change from one processed scan to the next, more than
+// the odometry errs between scans a metre apart. So each pose p_i becomes the mean of
+// the poses its neighbours give it through the odometry between them,
+// p_j ⊕ (o_j⁻¹ ⊕ o_i), weighted by a Gaussian of the travel between them along the
+// trajectory (σ = kSmoothSigmaM; a radian of turn counts kSmoothTurnM; neighbours
+// within 2σ). A neighbour whose odometry puts p_i more than kSmoothGateM from where the
+// trajectory has it is left out: a wheel slip, or a log without odometry, is not
+// averaged in. What the map fixes over longer stretches, loops included, stays as it
+// was. `trajectory` must be assemble_trajectory()'s for `scans` (a pose per scan, in
+// order); anything else is returned unchanged. Deterministic (det:: math, fixed order).
+inline constexpr double kSmoothSigmaM = 0.5;
+inline constexpr double kSmoothTurnM = 0.3;
+inline constexpr double kSmoothGateM = 0.2;
+std::vector<io::StampedPose> smooth_with_odometry(const std::vector<ScanRecord>& scans,
+                                                  const std::vector<io::StampedPose>& trajectory);
+
 // The best particle's map. Returns the number of known cells; `image` stays empty
 // (width 0) when nothing was ever written.
 std::uint32_t best_map_image(const DpSlamFilter& filter, io::OccupancyImage* image);
