@@ -1,7 +1,7 @@
 // Along-track bias of the bottom level's observation model (core/bottom/beam_model.h).
 // A plain program (not a test) that prints figures; build it in a Release directory:
 //   cmake --build --preset host-release --target bench_beam_bias
-//   build/host-release/tests/dpslam_filter/bench_beam_bias
+//   build/host-release/tests/dpslam_filter/bench_beam_bias [section.key=value ...]
 //
 // A robot drives straight down a 3 m corridor in 0.2 m steps; exact scans (181 beams over
 // 180 deg, 1 cm range noise) are written into one lineage of the DP map from the TRUE
@@ -14,17 +14,25 @@
 // Rows: plain walls (only the corridor's end walls constrain the motion along it) or
 // walls with door recesses every 3 m; laser reach 8 m or 30 m; corridor along the grid
 // or turned 0.3 rad to it; the map written from the poses behind the robot only (as in
-// SLAM) or from every pose of the run first (every viewpoint). The last three columns
-// profile the same scans on a part of their beams only, by angle from the direction of
-// travel (0-30, 30-60 and 60-90 deg to either side): which beams carry the offset.
+// SLAM), from every pose of the run first (every viewpoint), or from the last 5 scans
+// only (a map as sparse as a new segment's: SDP-SLAM's bottom level starts each segment
+// with its first few scans, sdp_slam.h). The last three columns profile the same scans
+// on a part of their beams only, by angle from the direction of travel (0-30, 30-60 and
+// 60-90 deg to either side): which beams carry the offset.
+// Arguments: section.key=value ... (keys of DpSlamOptions::table(), as in the INI files,
+// e.g. observation.prior_hits=0.05) set the observation model's options (and
+// map.resolution_m the grid's), so that one option's share of the offset can be measured.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "sdpslam/core/bottom/beam_model.h"
 #include "sdpslam/core/dpslam_options.h"
+#include "sdpslam/slam/option_text.h"
 #include "sim_world.h"
 
 namespace {
@@ -32,13 +40,20 @@ namespace {
 using namespace sdpslam;
 
 constexpr double kStep_m = 0.2;  // travel between scans
+constexpr int kRecentScans = 5;  // the sparse map's scans
+
+// Where the map the scans are profiled against comes from.
+enum class History { kBehind, kEveryPose, kRecent };
 
 struct Case {
   bool doors;
   double reach_m;
   double heading_rad;
-  bool every_viewpoint;
+  History history;
 };
+
+// The default options with the command line's overrides.
+DpSlamOptions g_options;
 
 constexpr int kSectors = 3;  // beams by angle from the direction of travel, 30 deg each
 
@@ -57,20 +72,31 @@ bool run_case(const Case& k, Result* out) {
   mo.origin_y_m = -10.0;
   mo.width_m = 80.0;
   mo.height_m = 40.0;
-  mo.resolution_m = 0.05;
+  mo.resolution_m = g_options.map_resolution_m;
   mo.tile_capacity = 6000U;
   mo.observation_capacity = 2000000U;
   std::vector<unsigned char> buffer(AncestryTree::required_arena_bytes(4, 4) + DpMap::required_arena_bytes(mo, 4) + 4096U);
   Arena arena;
-  arena.reset(buffer.data(), buffer.size());
-  AncestryTree tree;
-  DpMap map;
+  std::unique_ptr<DpMap> map_ptr;
+  std::unique_ptr<AncestryTree> tree_ptr;
+  NodeId lineage = kNoNode;
+  // An empty map (again).
+  auto fresh_map = [&]() {
+    map_ptr.reset();
+    tree_ptr = std::make_unique<AncestryTree>();
+    map_ptr = std::make_unique<DpMap>();
+    arena.reset(buffer.data(), buffer.size());
+    if (!tree_ptr->init(arena, 4, 4) || !map_ptr->init(arena, mo, *tree_ptr)) return false;
+    lineage = tree_ptr->create_root();
+    return lineage != kNoNode;
+  };
   BeamModel beam;
-  const DpSlamOptions defaults;
-  if (!tree.init(arena, 4, 4) || !map.init(arena, mo, tree) || !beam.init(defaults.beam, mo.resolution_m)) return false;
-  const NodeId lineage = tree.create_root();
+  if (!fresh_map() || !beam.init(g_options.beam, mo.resolution_m)) return false;
   auto scan = std::make_unique<RangeScan>();
   auto rays = std::make_unique<ScanRays>();
+  std::vector<ScanRays> recent(kRecentScans);  // ring of the last scans (History::kRecent)
+  std::vector<Pose2> recent_pose(kRecentScans);
+  int recent_count = 0;
   Rng noise(5U);
   const double c = std::cos(k.heading_rad);
   const double s = std::sin(k.heading_rad);
@@ -83,10 +109,10 @@ bool run_case(const Case& k, Result* out) {
     prepare_rays(*scan, rays.get());
   };
   const int steps = static_cast<int>((kLength - 20.0) / kStep_m);
-  if (k.every_viewpoint) {
+  if (k.history == History::kEveryPose) {
     for (int i = 0; i < steps; ++i) {
       make(pose_at(kStep_m * i));
-      beam.update_map(map, lineage, *rays, pose_at(kStep_m * i));
+      beam.update_map(*map_ptr, lineage, *rays, pose_at(kStep_m * i));
     }
   }
   // The offset of the log-likelihood's maximum along the corridor from `along`, on the
@@ -106,7 +132,7 @@ bool run_case(const Case& k, Result* out) {
     double best_offset = 0.0;
     for (int j = -20; j <= 20; ++j) {
       const double offset = 0.0025 * j;
-      const double ll = beam.log_likelihood_strided(map, lineage, *rays, pose_at(along + offset), 1U, nullptr);
+      const double ll = beam.log_likelihood_strided(*map_ptr, lineage, *rays, pose_at(along + offset), 1U, nullptr);
       if (ll > best) {
         best = ll;
         best_offset = offset;
@@ -122,6 +148,10 @@ bool run_case(const Case& k, Result* out) {
   for (int i = 0; i < steps; ++i) {
     const double along = kStep_m * i;
     make(pose_at(along));
+    if (k.history == History::kRecent && recent_count >= kRecentScans) {
+      if (!fresh_map()) return false;
+      for (int j = 0; j < kRecentScans; ++j) beam.update_map(*map_ptr, lineage, recent[j], recent_pose[j]);
+    }
     if (along > 5.0) {  // some map behind the robot first
       const double best_offset = peak_offset(along, -1);
       sum += best_offset;
@@ -129,7 +159,10 @@ bool run_case(const Case& k, Result* out) {
       for (int q = 0; q < kSectors; ++q) sector_sum[q] += peak_offset(along, q);
       ++n;
     }
-    if (!k.every_viewpoint) beam.update_map(map, lineage, *rays, pose_at(along));
+    if (k.history == History::kBehind) beam.update_map(*map_ptr, lineage, *rays, pose_at(along));
+    recent[recent_count % kRecentScans] = *rays;
+    recent_pose[recent_count % kRecentScans] = pose_at(along);
+    ++recent_count;
   }
   out->mean_m = n > 0 ? sum / n : 0.0;
   out->mean_abs_m = n > 0 ? sum_abs / n : 0.0;
@@ -140,7 +173,36 @@ bool run_case(const Case& k, Result* out) {
 
 }  // namespace
 
-int main() {
+// Sets `o`'s field from section.key=value (the INI files' dialect, slam::set_option_text);
+// false, with *why, if it is not one or the options are then invalid.
+bool apply(const char* arg, DpSlamOptions* o, std::string* why) {
+  const char* dot = std::strchr(arg, '.');
+  const char* eq = std::strchr(arg, '=');
+  const OptionSpec<DpSlamOptions>* row =
+      dot != nullptr && eq != nullptr && dot < eq
+          ? DpSlamOptions::table().find(std::string(arg, static_cast<std::size_t>(dot - arg)).c_str(),
+                                        std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
+          : nullptr;
+  if (row == nullptr) {
+    *why = "not section.key=value of a DpSlamOptions key";
+    return false;
+  }
+  if (!slam::set_option_text(*row, o, eq + 1, why)) return false;
+  char reason[256] = {};
+  if (o->validate(reason, sizeof reason)) return true;
+  *why = reason;
+  return false;
+}
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string why;
+    if (!apply(argv[i], &g_options, &why)) {
+      std::fprintf(stderr, "bench_beam_bias: '%s': %s\n", argv[i], why.c_str());
+      return 2;
+    }
+    std::printf("with %s\n", argv[i]);
+  }
   std::printf("| walls | laser reach | corridor to the grid | map written from | mean offset of the peak | mean |offset| | as path length per %.1f m step | scans | beams 0-30 deg | beams 30-60 deg | beams 60-90 deg |\n",
               kStep_m);
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
@@ -148,14 +210,17 @@ int main() {
   for (bool doors : {false, true}) {
     for (double reach : {8.0, 30.0}) {
       for (double heading : {0.0, 0.3}) {
-        for (bool every : {false, true}) {
+        for (History history : {History::kBehind, History::kEveryPose, History::kRecent}) {
           Result r;
-          if (!run_case(Case{doors, reach, heading, every}, &r)) {
+          if (!run_case(Case{doors, reach, heading, history}, &r)) {
             ++failed;
             continue;
           }
           std::printf("| %s | %.0f m | %.1f rad | %s | %+.1f mm | %.1f mm | %+.2f %% | %d | %+.1f mm | %+.1f mm | %+.1f mm |\n",
-                      doors ? "door recesses" : "plain", reach, heading, every ? "every pose" : "poses behind",
+                      doors ? "door recesses" : "plain", reach, heading,
+                      history == History::kBehind      ? "poses behind"
+                      : history == History::kEveryPose ? "every pose"
+                                                       : "last 5 scans",
                       r.mean_m * 1e3, r.mean_abs_m * 1e3, 100.0 * r.mean_m / kStep_m, r.scans,
                       r.sector_mean_m[0] * 1e3, r.sector_mean_m[1] * 1e3, r.sector_mean_m[2] * 1e3);
         }
