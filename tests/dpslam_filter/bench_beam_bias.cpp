@@ -25,14 +25,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "sdpslam/core/bottom/beam_model.h"
 #include "sdpslam/core/dpslam_options.h"
-#include "sdpslam/slam/option_text.h"
+#include "option_override.h"
 #include "sim_world.h"
 
 namespace {
@@ -173,31 +172,11 @@ bool run_case(const Case& k, Result* out) {
 
 }  // namespace
 
-// Sets `o`'s field from section.key=value (the INI files' dialect, slam::set_option_text);
-// false, with *why, if it is not one or the options are then invalid.
-bool apply(const char* arg, DpSlamOptions* o, std::string* why) {
-  const char* dot = std::strchr(arg, '.');
-  const char* eq = std::strchr(arg, '=');
-  const OptionSpec<DpSlamOptions>* row =
-      dot != nullptr && eq != nullptr && dot < eq
-          ? DpSlamOptions::table().find(std::string(arg, static_cast<std::size_t>(dot - arg)).c_str(),
-                                        std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
-          : nullptr;
-  if (row == nullptr) {
-    *why = "not section.key=value of a DpSlamOptions key";
-    return false;
-  }
-  if (!slam::set_option_text(*row, o, eq + 1, why)) return false;
-  char reason[256] = {};
-  if (o->validate(reason, sizeof reason)) return true;
-  *why = reason;
-  return false;
-}
-
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
+    test::OptionOverride v;
     std::string why;
-    if (!apply(argv[i], &g_options, &why)) {
+    if (!test::parse_override(argv[i], g_options, &v, &why) || !test::apply_override(v, &g_options, &why)) {
       std::fprintf(stderr, "bench_beam_bias: '%s': %s\n", argv[i], why.c_str());
       return 2;
     }

@@ -24,13 +24,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
 #include "filter_harness.h"
 #include "sdpslam/core/sdp_profile.h"
-#include "sdpslam/slam/option_text.h"
+#include "option_override.h"
 
 namespace {
 
@@ -39,24 +38,7 @@ using namespace sdpslam;
 constexpr double kTravel_m = 60.0;
 constexpr double kOdometryStep_m = 0.1;
 
-// One section.key=value: the row and its value as text.
-struct Override {
-  const OptionSpec<DpSlamOptions>* row;
-  std::string value;
-};
-
-// Sets `o`'s field from text (the INI files' dialect, slam::set_option_text); false, with
-// *why, if the text is not a value of the row or the options are then invalid
-// (DpSlamOptions::validate's reason).
-bool apply(const Override& v, DpSlamOptions* o, std::string* why) {
-  if (!slam::set_option_text(*v.row, o, v.value.c_str(), why)) return false;
-  char reason[256] = {};
-  if (o->validate(reason, sizeof reason)) return true;
-  *why = reason;
-  return false;
-}
-
-std::vector<Override> g_overrides;
+std::vector<test::OptionOverride> g_overrides;
 
 // The bottom level as `sdpslam run` configures it by default (sdp_profile.h).
 DpSlamOptions product_options() {
@@ -86,8 +68,8 @@ double travel_m(const Row& row, std::uint64_t seed) {
   }
   o.proposal = row.scan_match ? DpSlamOptions::Proposal::kScanMatch : DpSlamOptions::Proposal::kOdometry;
   std::string why;
-  for (const Override& v : g_overrides) {
-    if (!apply(v, &o, &why)) return std::nan("");
+  for (const test::OptionOverride& v : g_overrides) {
+    if (!test::apply_override(v, &o, &why)) return std::nan("");
   }
   test::FilterRig rig;
   if (!rig.init(o, seed)) return std::nan("");
@@ -109,20 +91,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   for (int i = 2; i < argc; ++i) {
-    const char* dot = std::strchr(argv[i], '.');
-    const char* eq = std::strchr(argv[i], '=');
-    const OptionSpec<DpSlamOptions>* row =
-        dot != nullptr && eq != nullptr && dot < eq
-            ? DpSlamOptions::table().find(std::string(argv[i], static_cast<std::size_t>(dot - argv[i])).c_str(),
-                                          std::string(dot + 1, static_cast<std::size_t>(eq - dot - 1)).c_str())
-            : nullptr;
-    DpSlamOptions check = product_options();
-    std::string why = "not section.key=value of a [filter] option";
-    if (row == nullptr || !apply(Override{row, eq + 1}, &check, &why)) {
+    test::OptionOverride v;
+    std::string why;
+    if (!test::parse_override(argv[i], product_options(), &v, &why)) {
       std::fprintf(stderr, "bench_corridor_travel: '%s': %s\n", argv[i], why.c_str());
       return 2;
     }
-    g_overrides.push_back(Override{row, eq + 1});
+    g_overrides.push_back(v);
     std::printf("with %s\n", argv[i]);
   }
   std::printf("| walls | proposal | translation noise | mean travel error | worst seed | seeds |\n");

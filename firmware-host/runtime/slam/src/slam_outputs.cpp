@@ -79,7 +79,7 @@ std::vector<io::StampedPose> smooth_with_odometry(const std::vector<ScanRecord>&
       ss += w * det::sin(dh);
       sw += w;
     }
-    if (!(sw > 0.0)) continue;  // p_i itself always counts; cannot happen
+    if (!(sw > 0.0)) continue;  // p_i itself counts, so only a non-finite pose: left as it was
     out[i].pose = Pose2{own.x_m + sx / sw, own.y_m + sy / sw, normalize_angle_rad(own.heading_rad + det::atan2(ss, sc))};
   }
   return out;
