@@ -18,12 +18,19 @@
 // Without translation noise the exact odometry pins each step's length; what is left
 // comes from the heading noise (a path that wanders covers less of the corridor) and,
 // with scan matching, from the noise drawn around each match.
+// Then one run is diagnosed (plain corridor, scan matching, no translation noise, seed
+// 1): the mean log-likelihood of each new scan along the robot's heading around where
+// its proposal starts (a slope there is what the scan match follows against the motion
+// prior), and the hits and misses of the wall cells behind, beside and ahead of the
+// robot at the end: a wall seen so far only from behind, at grazing incidence, holds
+// the misses of beams that passed through its cells' free part and few hits yet.
 // Each section.key=value (a key of DpSlamOptions::table(), as in the INI files, e.g.
 // observation.likelihood_temperature=5) is set on every row's options after the row's
 // own, so that one option's share of the error can be measured.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,9 +60,74 @@ struct Row {
   bool translation_noise;
 };
 
+// What the diagnosed run (`diagnose` of travel_m()) measured.
+constexpr int kShifts = 7;  // -6 .. +6 cm along the corridor
+constexpr double kShiftStep_m = 0.02;
+constexpr double kWallFrom_m[] = {-2.0, 0.0, 1.0, 2.0, 4.0, 6.0, 8.0};
+constexpr double kWallStretch_m = 0.5;
+constexpr double kProfileAfter_m = 2.0;  // the first scans see a map still being started
+struct Diagnosis {
+  double log_likelihood_sum[kShifts] = {};  // relative to the prediction's
+  int scans = 0;
+  std::uint32_t wall_hits[sizeof kWallFrom_m / sizeof kWallFrom_m[0]] = {};
+  std::uint32_t wall_misses[sizeof kWallFrom_m / sizeof kWallFrom_m[0]] = {};
+};
+
+// Before each scan: the beam model's log-likelihood of that scan in the best particle's
+// map at the pose the odometry predicts from that particle (where its proposal starts),
+// moved along its heading by each shift.
+void profile_scan(const test::FilterRig& rig, const BeamModel& beam, const Pose2& predicted, Diagnosis* d) {
+  auto rays = std::make_unique<ScanRays>();
+  prepare_rays(*rig.scan, rays.get());
+  const NodeId node = rig.filter->best_node();
+  const double at_prediction = beam.log_likelihood(rig.filter->map(), node, *rays, predicted);
+  for (int k = 0; k < kShifts; ++k) {
+    const Pose2 moved = predicted.compose(Pose2{kShiftStep_m * (k - kShifts / 2), 0.0, 0.0});
+    d->log_likelihood_sum[k] += beam.log_likelihood(rig.filter->map(), node, *rays, moved) - at_prediction;
+  }
+  ++d->scans;
+}
+
+// After the run: the counts of both walls' cells, in stretches of kWallStretch_m from
+// each distance ahead of the robot (negative: behind). A wall's row is the row at its
+// side, or next to it, with the most hits (the wall may lie on a cell boundary).
+void count_wall(const test::FilterRig& rig, const DpSlamOptions& o, const Pose2& robot, Diagnosis* d) {
+  const DpMap& map = rig.filter->map();
+  const NodeId node = rig.filter->best_node();
+  const double res = o.map_resolution_m;
+  const auto cell = [&](double v, double origin) { return static_cast<std::int32_t>(std::floor((v - origin) / res)); };
+  for (double wall_y : {-1.5, 1.5}) {
+    const std::int32_t iy_wall = cell(wall_y, map.options().origin_y_m);
+    const std::int32_t ix_robot = cell(robot.x_m, map.options().origin_x_m);
+    const auto stretch = static_cast<std::int32_t>(kWallStretch_m / res + 0.5);
+    std::int32_t best_row = iy_wall;
+    std::uint64_t best_hits = 0U;
+    for (std::int32_t iy = iy_wall - 1; iy <= iy_wall + 1; ++iy) {
+      std::uint64_t hits = 0U;
+      for (std::int32_t ix = ix_robot - 100; ix <= ix_robot + 100; ++ix) {
+        CellObservation v;
+        if (map.lookup(node, ix, iy, &v)) hits += v.hits;
+      }
+      if (hits > best_hits) {
+        best_hits = hits;
+        best_row = iy;
+      }
+    }
+    for (std::size_t k = 0; k < sizeof kWallFrom_m / sizeof kWallFrom_m[0]; ++k) {
+      const std::int32_t ix0 = ix_robot + static_cast<std::int32_t>(std::lround(kWallFrom_m[k] / res));
+      for (std::int32_t ix = ix0; ix < ix0 + stretch; ++ix) {
+        CellObservation v;
+        if (!map.lookup(node, ix, best_row, &v)) continue;
+        d->wall_hits[k] += v.hits;
+        d->wall_misses[k] += v.misses;
+      }
+    }
+  }
+}
+
 // The best particle's travel along the corridor (x) after the run, or NaN if the filter
-// could not be set up.
-double travel_m(const Row& row, std::uint64_t seed) {
+// could not be set up. With `diagnose`, also fills it.
+double travel_m(const Row& row, std::uint64_t seed, Diagnosis* diagnose = nullptr) {
   DpSlamOptions o = product_options();
   o.map_width_m = 2.0 * (kTravel_m + 10.0);  // centred on the first pose
   o.map_height_m = 20.0;
@@ -78,7 +150,18 @@ double travel_m(const Row& row, std::uint64_t seed) {
   const int steps = static_cast<int>(kTravel_m / kOdometryStep_m + 0.5);
   for (int i = 0; i <= steps; ++i) run.truth.push_back(Pose2{kOdometryStep_m * i, 0.0, 0.0});
   run.odom = run.truth;
-  for (std::size_t i = 0; i < run.truth.size(); ++i) rig.step(run, world, i);
+  BeamModel beam;
+  if (diagnose != nullptr && !beam.init(o.beam, o.map_resolution_m)) return std::nan("");
+  std::size_t last_processed = 0U;
+  for (std::size_t i = 0; i < run.truth.size(); ++i) {
+    if (diagnose != nullptr && run.truth[i].x_m >= kProfileAfter_m) {
+      test::make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, rig.scan.get());
+      const Pose2 predicted = rig.filter->best_pose().compose(between(run.odom[last_processed], run.odom[i]));
+      profile_scan(rig, beam, predicted, diagnose);
+    }
+    if (rig.step(run, world, i).status == StepResult::Status::kProcessed) last_processed = i;
+  }
+  if (diagnose != nullptr) count_wall(rig, o, run.truth.back(), diagnose);
   return rig.filter->best_pose().x_m;
 }
 
@@ -125,6 +208,36 @@ int main(int argc, char** argv) {
         std::printf("| %s | %s | %s | %+.2f %% | %+.2f %% (%ld) | %ld |\n", doors ? "door recesses" : "plain",
                     scan_match ? "scan match" : "odometry", noise ? "default" : "none", sum / static_cast<double>(seeds),
                     worst, worst_seed, seeds);
+      }
+    }
+  }
+  // Why the path comes out short: the run of the plain corridor with scan matching and
+  // no translation noise (its poses stay right along the corridor), seed 1.
+  Diagnosis d;
+  if (std::isnan(travel_m(Row{false, true, false}, 1U, &d)) || d.scans == 0) {
+    ++failed;
+  } else {
+    std::printf("\nPlain corridor, scan match, no translation noise, seed 1: mean log-likelihood of each new scan "
+                "(%d scans) in the best particle's map, at the odometry's prediction from that particle moved along "
+                "its heading, relative to the prediction\n\n",
+                d.scans);
+    std::printf("| shift |");
+    for (int k = 0; k < kShifts; ++k) std::printf(" %+.0f cm |", 100.0 * kShiftStep_m * (k - kShifts / 2));
+    std::printf("\n|---|");
+    for (int k = 0; k < kShifts; ++k) std::printf("---|");
+    std::printf("\n| log-likelihood |");
+    for (int k = 0; k < kShifts; ++k) std::printf(" %+.3f |", d.log_likelihood_sum[k] / d.scans);
+    std::printf("\n\nThe same run's map after the run: both walls' cells, %.1f m of each from the distance given "
+                "(negative: behind the robot)\n\n",
+                kWallStretch_m);
+    std::printf("| from the robot | hits | misses | hits / (hits + misses) |\n|---|---|---|---|\n");
+    for (std::size_t k = 0; k < sizeof kWallFrom_m / sizeof kWallFrom_m[0]; ++k) {
+      const std::uint32_t n = d.wall_hits[k] + d.wall_misses[k];
+      std::printf("| %+.1f m | %u | %u | ", kWallFrom_m[k], d.wall_hits[k], d.wall_misses[k]);
+      if (n > 0U) {
+        std::printf("%.2f |\n", static_cast<double>(d.wall_hits[k]) / static_cast<double>(n));
+      } else {
+        std::printf("- |\n");
       }
     }
   }
