@@ -30,6 +30,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,21 +65,22 @@ struct Row {
 constexpr int kShifts = 7;  // -6 .. +6 cm along the corridor
 constexpr double kShiftStep_m = 0.02;
 constexpr double kWallFrom_m[] = {-2.0, 0.0, 1.0, 2.0, 4.0, 6.0, 8.0};
+constexpr std::size_t kWallStretches = std::size(kWallFrom_m);
 constexpr double kWallStretch_m = 0.5;
 constexpr double kProfileAfter_m = 2.0;  // the first scans see a map still being started
 struct Diagnosis {
   double log_likelihood_sum[kShifts] = {};  // relative to the prediction's
   int scans = 0;
-  std::uint32_t wall_hits[sizeof kWallFrom_m / sizeof kWallFrom_m[0]] = {};
-  std::uint32_t wall_misses[sizeof kWallFrom_m / sizeof kWallFrom_m[0]] = {};
+  std::uint32_t wall_hits[kWallStretches] = {};
+  std::uint32_t wall_misses[kWallStretches] = {};
 };
 
-// Before each scan: the beam model's log-likelihood of that scan in the best particle's
-// map at the pose the odometry predicts from that particle (where its proposal starts),
-// moved along its heading by each shift.
-void profile_scan(const test::FilterRig& rig, const BeamModel& beam, const Pose2& predicted, Diagnosis* d) {
-  auto rays = std::make_unique<ScanRays>();
-  prepare_rays(*rig.scan, rays.get());
+// Before each scan: the beam model's log-likelihood of that scan (its rays in *rays) in
+// the best particle's map at the pose the odometry predicts from that particle (where
+// its proposal starts), moved along its heading by each shift.
+void profile_scan(const test::FilterRig& rig, const BeamModel& beam, const Pose2& predicted, ScanRays* rays,
+                  Diagnosis* d) {
+  prepare_rays(*rig.scan, rays);
   const NodeId node = rig.filter->best_node();
   const double at_prediction = beam.log_likelihood(rig.filter->map(), node, *rays, predicted);
   for (int k = 0; k < kShifts; ++k) {
@@ -90,38 +92,39 @@ void profile_scan(const test::FilterRig& rig, const BeamModel& beam, const Pose2
 
 // After the run: the counts of both walls' cells, in stretches of kWallStretch_m from
 // each distance ahead of the robot (negative: behind). A wall's row is the row at its
-// side, or next to it, with the most hits (the wall may lie on a cell boundary).
-void count_wall(const test::FilterRig& rig, const DpSlamOptions& o, const Pose2& robot, Diagnosis* d) {
+// side, or next to it, with the most hits in the stretches (the wall may lie on a cell
+// boundary).
+void count_wall(const test::FilterRig& rig, const Pose2& robot, Diagnosis* d) {
   const DpMap& map = rig.filter->map();
   const NodeId node = rig.filter->best_node();
-  const double res = o.map_resolution_m;
-  const auto cell = [&](double v, double origin) { return static_cast<std::int32_t>(std::floor((v - origin) / res)); };
+  const double res = map.options().resolution_m;
+  const auto stretch = static_cast<std::int32_t>(kWallStretch_m / res + 0.5);
   for (double wall_y : {-1.5, 1.5}) {
-    const std::int32_t iy_wall = cell(wall_y, map.options().origin_y_m);
-    const std::int32_t ix_robot = cell(robot.x_m, map.options().origin_x_m);
-    const auto stretch = static_cast<std::int32_t>(kWallStretch_m / res + 0.5);
-    std::int32_t best_row = iy_wall;
-    std::uint64_t best_hits = 0U;
-    for (std::int32_t iy = iy_wall - 1; iy <= iy_wall + 1; ++iy) {
-      std::uint64_t hits = 0U;
-      for (std::int32_t ix = ix_robot - 100; ix <= ix_robot + 100; ++ix) {
-        CellObservation v;
-        if (map.lookup(node, ix, iy, &v)) hits += v.hits;
-      }
-      if (hits > best_hits) {
-        best_hits = hits;
-        best_row = iy;
-      }
-    }
-    for (std::size_t k = 0; k < sizeof kWallFrom_m / sizeof kWallFrom_m[0]; ++k) {
+    std::int32_t ix_robot;
+    std::int32_t iy_wall;
+    if (!map.world_to_cell(robot.x_m, wall_y, &ix_robot, &iy_wall)) continue;
+    // Row iy's counts in stretch k.
+    const auto count = [&](std::int32_t iy, std::size_t k, std::uint32_t* hits, std::uint32_t* misses) {
       const std::int32_t ix0 = ix_robot + static_cast<std::int32_t>(std::lround(kWallFrom_m[k] / res));
       for (std::int32_t ix = ix0; ix < ix0 + stretch; ++ix) {
         CellObservation v;
-        if (!map.lookup(node, ix, best_row, &v)) continue;
-        d->wall_hits[k] += v.hits;
-        d->wall_misses[k] += v.misses;
+        if (!map.lookup(node, ix, iy, &v)) continue;
+        *hits += v.hits;
+        *misses += v.misses;
+      }
+    };
+    std::int32_t wall_row = iy_wall;
+    std::uint32_t wall_row_hits = 0U;
+    for (std::int32_t iy = iy_wall - 1; iy <= iy_wall + 1; ++iy) {
+      std::uint32_t hits = 0U;
+      std::uint32_t misses = 0U;
+      for (std::size_t k = 0; k < kWallStretches; ++k) count(iy, k, &hits, &misses);
+      if (hits > wall_row_hits) {
+        wall_row_hits = hits;
+        wall_row = iy;
       }
     }
+    for (std::size_t k = 0; k < kWallStretches; ++k) count(wall_row, k, &d->wall_hits[k], &d->wall_misses[k]);
   }
 }
 
@@ -151,17 +154,21 @@ double travel_m(const Row& row, std::uint64_t seed, Diagnosis* diagnose = nullpt
   for (int i = 0; i <= steps; ++i) run.truth.push_back(Pose2{kOdometryStep_m * i, 0.0, 0.0});
   run.odom = run.truth;
   BeamModel beam;
-  if (diagnose != nullptr && !beam.init(o.beam, o.map_resolution_m)) return std::nan("");
+  std::unique_ptr<ScanRays> rays;
+  if (diagnose != nullptr) {
+    if (!beam.init(o.beam, o.map_resolution_m)) return std::nan("");
+    rays = std::make_unique<ScanRays>();
+  }
   std::size_t last_processed = 0U;
   for (std::size_t i = 0; i < run.truth.size(); ++i) {
     if (diagnose != nullptr && run.truth[i].x_m >= kProfileAfter_m) {
       test::make_scan(world, run.truth[i], static_cast<std::int64_t>(i) * 100000, rig.scan.get());
       const Pose2 predicted = rig.filter->best_pose().compose(between(run.odom[last_processed], run.odom[i]));
-      profile_scan(rig, beam, predicted, diagnose);
+      profile_scan(rig, beam, predicted, rays.get(), diagnose);
     }
     if (rig.step(run, world, i).status == StepResult::Status::kProcessed) last_processed = i;
   }
-  if (diagnose != nullptr) count_wall(rig, o, run.truth.back(), diagnose);
+  if (diagnose != nullptr) count_wall(rig, run.truth.back(), diagnose);
   return rig.filter->best_pose().x_m;
 }
 
@@ -231,7 +238,7 @@ int main(int argc, char** argv) {
                 "(negative: behind the robot)\n\n",
                 kWallStretch_m);
     std::printf("| from the robot | hits | misses | hits / (hits + misses) |\n|---|---|---|---|\n");
-    for (std::size_t k = 0; k < sizeof kWallFrom_m / sizeof kWallFrom_m[0]; ++k) {
+    for (std::size_t k = 0; k < kWallStretches; ++k) {
       const std::uint32_t n = d.wall_hits[k] + d.wall_misses[k];
       std::printf("| %+.1f m | %u | %u | ", kWallFrom_m[k], d.wall_hits[k], d.wall_misses[k]);
       if (n > 0U) {
