@@ -1,8 +1,10 @@
 // The submaps' storage (paper §III, Fig. 3) through its own API: live submaps by level
-// slot, and the ring of permanent submaps that forgets its oldest when full.
+// slot, and the ring of permanent submaps that forgets its oldest when full and keeps
+// its skeleton points as cells of their grid.
 #include <CppUTest/TestHarness.h>
 
 #include <cstdint>
+#include <cstring>
 
 #include "sdpslam/core/arena.h"
 #include "top/submap_store.h"
@@ -11,6 +13,7 @@ using sdpslam::Arena;
 using sdpslam::CellPoint;
 using sdpslam::PermanentSubmap;
 using sdpslam::Point2;
+using sdpslam::SkeletonGrid;
 using sdpslam::Submap;
 using sdpslam::SubmapStore;
 using sdpslam::SubmapStoreOptions;
@@ -40,6 +43,7 @@ void fill(SubmapStore& store, std::uint32_t level, std::uint32_t node) {
   sm.box[2] = tag;
   sm.point_count = 1U + node;
   sm.obstacle_count = 2U + node;
+  sm.skeleton_grid = SkeletonGrid{-0.5, -0.5, 1.0};  // cell centres at whole metres
   for (std::uint32_t i = 0; i < sm.point_count; ++i) store.points(level, node)[i] = Point2{tag, static_cast<double>(i)};
   for (std::uint32_t i = 0; i < sm.obstacle_count; ++i) {
     store.obstacles(level, node)[i] = CellPoint{static_cast<std::uint16_t>(10U * level + node), static_cast<std::uint16_t>(i)};
@@ -146,4 +150,42 @@ TEST(SubmapStore, a_full_ring_forgets_its_oldest) {
     DOUBLES_EQUAL(100.0 * level + level % 3U, store.permanent_points(slot)[0].x_m, 0.0);
   }
   CHECK_FALSE(store.find_permanent(5U, &slot));
+}
+
+TEST(SubmapStore, a_permanent_skeleton_is_kept_as_grid_cells_and_comes_back_bit_for_bit) {
+  Arena arena(g_buffer, sizeof g_buffer);
+  SubmapStoreOptions o = options();
+  o.skeleton_points = 64U;
+  SubmapStore store;
+  CHECK_TRUE(store.init(o, arena));
+  // A skeleton as FreeSpaceSkeleton emits it: origin + (cell + 0.5) × cell size, on a
+  // grid whose origin and cell are not round numbers.
+  Submap& sm = store.submap(0U, 1U);
+  sm = Submap{};
+  sm.skeleton_grid = SkeletonGrid{-37.15, 12.05, 0.1};
+  const SkeletonGrid& g = sm.skeleton_grid;
+  Point2 emitted[64];
+  for (std::uint32_t i = 0; i < 63U; ++i) {
+    const std::uint32_t x = (i * 37U) % 300U;
+    const std::uint32_t y = (i * 101U) % 300U;
+    emitted[i] = Point2{g.origin_x_m + (static_cast<double>(x) + 0.5) * g.cell_m,
+                        g.origin_y_m + (static_cast<double>(y) + 0.5) * g.cell_m};
+  }
+  // And one point off the grid: it is kept at the nearest cell centre.
+  emitted[63] = Point2{g.origin_x_m + 4.54 * g.cell_m, g.origin_y_m + 0.3 * g.cell_m};
+  sm.point_count = 64U;
+  for (std::uint32_t i = 0; i < 64U; ++i) store.points(0U, 1U)[i] = emitted[i];
+  bool forgot = true;
+  const std::uint32_t slot = store.make_permanent(0U, 1U, &forgot);
+  sm.point_count = 0U;  // the live slot may be reused: the permanent copy stays
+  store.points(0U, 1U)[0] = Point2{1.0e6, 1.0e6};
+  const Point2* kept = store.permanent_points(slot);
+  CHECK_EQUAL(0, std::memcmp(emitted, kept, 63U * sizeof(Point2)));
+  DOUBLES_EQUAL(g.origin_x_m + 4.5 * g.cell_m, kept[63].x_m, 1e-12);
+  DOUBLES_EQUAL(g.origin_y_m + 0.5 * g.cell_m, kept[63].y_m, 1e-12);
+  // Four bytes a point, not a Point2's sixteen.
+  SubmapStoreOptions more = o;
+  more.max_permanent = o.max_permanent + 1U;
+  CHECK_TRUE(SubmapStore::required_bytes(more) - SubmapStore::required_bytes(o) <
+             sizeof(PermanentSubmap) + 4U * o.skeleton_points + 4U * o.obstacle_points + 64U);
 }

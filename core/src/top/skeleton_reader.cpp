@@ -129,6 +129,7 @@ SkeletonStep SkeletonReader::work(std::uint32_t budget_cells, const DpSlamFilter
   so.min_clearance_m = options_.min_clearance_m;
   so.max_points = options_.skeleton_points;
   Point2* out = store.points(job.level, job.node);
+  sm.skeleton_grid = SkeletonGrid{patch.origin_x_m, patch.origin_y_m, patch.resolution_m};
   if (options_.obstacle_points > 0U) extract_obstacles(sm, store.obstacles(job.level, job.node), r, cw, ch);
   const SkeletonResult res = skeleton_.extract(patch, so, out, options_.skeleton_points);
   step.extracted = true;

@@ -1,6 +1,19 @@
 #include "top/submap_store.h"
 
 namespace sdpslam {
+namespace {
+
+// The cell of a grid (origin, cell size) whose centre is nearest to coordinate v,
+// clamped to 0 .. 65535; 0 for a grid without a cell size.
+std::uint16_t grid_cell(double v_m, double origin_m, double cell_m) {
+  if (!(cell_m > 0.0)) return 0U;
+  const double k = (v_m - origin_m) / cell_m - 0.5;
+  if (!(k > 0.0)) return 0U;
+  if (k >= 65535.0) return 65535U;
+  return static_cast<std::uint16_t>(k + 0.5);
+}
+
+}  // namespace
 
 bool SubmapStoreOptions::valid() const {
   return max_levels >= 1U && nodes >= 1U && skeleton_points >= 1U && max_permanent >= 1U;
@@ -11,7 +24,8 @@ std::size_t SubmapStore::required_bytes(const SubmapStoreOptions& o) {
   const std::size_t live = std::size_t{o.max_levels} * o.nodes;
   std::size_t total = Arena::bytes_for<Submap>(live) + Arena::bytes_for<Point2>(live * o.skeleton_points) +
                       Arena::bytes_for<SubmapLevel>(o.max_levels) + Arena::bytes_for<PermanentSubmap>(o.max_permanent) +
-                      Arena::bytes_for<Point2>(std::size_t{o.max_permanent} * o.skeleton_points);
+                      Arena::bytes_for<SkeletonCell>(std::size_t{o.max_permanent} * o.skeleton_points) +
+                      Arena::bytes_for<Point2>(o.skeleton_points);
   if (o.obstacle_points > 0U) {
     total += Arena::bytes_for<CellPoint>((live + o.max_permanent) * std::size_t{o.obstacle_points});
   }
@@ -26,7 +40,8 @@ bool SubmapStore::init(const SubmapStoreOptions& o, Arena& arena) {
   points_ = arena.allocate_array<Point2>(live * o.skeleton_points);
   levels_ = arena.allocate_array<SubmapLevel>(o.max_levels);
   perm_ = arena.allocate_array<PermanentSubmap>(o.max_permanent);
-  perm_points_ = arena.allocate_array<Point2>(std::size_t{o.max_permanent} * o.skeleton_points);
+  perm_cells_ = arena.allocate_array<SkeletonCell>(std::size_t{o.max_permanent} * o.skeleton_points);
+  perm_unpacked_ = arena.allocate_array<Point2>(o.skeleton_points);
   obstacles_ = nullptr;
   perm_obstacles_ = nullptr;
   if (o.obstacle_points > 0U) {
@@ -35,7 +50,8 @@ bool SubmapStore::init(const SubmapStoreOptions& o, Arena& arena) {
     if (obstacles_ == nullptr) return false;
     perm_obstacles_ = obstacles_ + live * o.obstacle_points;
   }
-  if (submaps == nullptr || points_ == nullptr || levels_ == nullptr || perm_ == nullptr || perm_points_ == nullptr) {
+  if (submaps == nullptr || points_ == nullptr || levels_ == nullptr || perm_ == nullptr || perm_cells_ == nullptr ||
+      perm_unpacked_ == nullptr) {
     return false;
   }
   options_ = o;
@@ -46,6 +62,18 @@ bool SubmapStore::init(const SubmapStoreOptions& o, Arena& arena) {
   perm_head_ = 0U;
   perm_count_ = 0U;
   return true;
+}
+
+const Point2* SubmapStore::permanent_points(std::uint32_t slot) const {
+  const PermanentSubmap& pm = perm_[slot];
+  const SkeletonCell* cells = perm_cells_ + std::size_t{slot} * options_.skeleton_points;
+  const SkeletonGrid& g = pm.skeleton_grid;
+  // The expression FreeSpaceSkeleton::extract() emits its points with.
+  for (std::uint32_t i = 0; i < pm.point_count; ++i) {
+    perm_unpacked_[i] = Point2{g.origin_x_m + (static_cast<double>(cells[i].x) + 0.5) * g.cell_m,
+                               g.origin_y_m + (static_cast<double>(cells[i].y) + 0.5) * g.cell_m};
+  }
+  return perm_unpacked_;
 }
 
 bool SubmapStore::find_permanent(std::uint32_t level, std::uint32_t* slot) const {
@@ -73,9 +101,14 @@ std::uint32_t SubmapStore::make_permanent(std::uint32_t level, std::uint32_t nod
   pm.start_stamp_us = this->level(level).start_stamp_us;
   pm.initial = sm.initial;
   pm.point_count = sm.point_count;
+  pm.skeleton_grid = sm.skeleton_grid;
   const Point2* src = points(level, node);
-  Point2* dst = permanent_points(slot);
-  for (std::uint32_t i = 0; i < sm.point_count; ++i) dst[i] = src[i];
+  SkeletonCell* dst = perm_cells_ + std::size_t{slot} * options_.skeleton_points;
+  const SkeletonGrid& g = sm.skeleton_grid;
+  for (std::uint32_t i = 0; i < sm.point_count; ++i) {
+    dst[i].x = grid_cell(src[i].x_m, g.origin_x_m, g.cell_m);
+    dst[i].y = grid_cell(src[i].y_m, g.origin_y_m, g.cell_m);
+  }
   if (obstacles_ != nullptr) {
     const CellPoint* from = obstacles(level, node);
     CellPoint* to = permanent_obstacles(slot);

@@ -14,6 +14,12 @@
 // samples and loop searches still match against it. When the ring is full the oldest
 // is forgotten (the caller counts it).
 //
+// A permanent submap is kept compactly, so that the ring can hold thousands: its
+// skeleton points are stored as the cells of the skeleton's own grid they are the
+// centres of (SkeletonCell, 4 bytes instead of a Point2's 16), and come back bit for bit
+// (permanent_points()): FreeSpaceSkeleton emits origin + (cell + 0.5) × cell size, and
+// the same expression is evaluated again.
+//
 // Memory: init() carves everything from an Arena (required_bytes()); nothing else
 // allocates. The ring's head and count are the only state outside the arena
 // (transfer_state()).
@@ -36,11 +42,26 @@ struct CellPoint {
   std::uint16_t iy = 0U;
 };
 
+// A skeleton point as the cell of its skeleton grid whose centre it is.
+struct SkeletonCell {
+  std::uint16_t x = 0U;
+  std::uint16_t y = 0U;
+};
+
+// The grid a submap's skeleton points were extracted on (GridPatchView): its origin and
+// cell, submap frame; cell_m = 0 until the skeleton exists.
+struct SkeletonGrid {
+  double origin_x_m = 0.0;
+  double origin_y_m = 0.0;
+  double cell_m = 0.0;
+};
+
 struct Submap {
   NodeId node = kNoNode;
   Pose2 initial;
   Pose2 final_pose;
   double box[4] = {0.0, 0.0, 0.0, 0.0};  // skeleton points' bounds, submap frame
+  SkeletonGrid skeleton_grid{};           // where its skeleton points lie
   CellRect map_rect{};                    // cells worth reading for its map
   CellRect path_rect{};                   // its path's cells (skeleton patch seed)
   std::uint32_t point_count = 0U;
@@ -64,6 +85,7 @@ struct PermanentSubmap {
   std::uint32_t obstacle_count = 0U;
   std::int64_t start_stamp_us = 0;  // its level's start (exclusive)
   Pose2 initial;                    // its segment's initial pose, submap frame
+  SkeletonGrid skeleton_grid{};     // its skeleton points' grid (they are kept as cells)
 };
 
 struct SubmapStoreOptions {
@@ -107,7 +129,9 @@ class SubmapStore {
   std::uint32_t permanent_slot_at(std::uint32_t k) const { return (perm_head_ + k) % options_.max_permanent; }
   PermanentSubmap& permanent(std::uint32_t slot) { return perm_[slot]; }
   const PermanentSubmap& permanent(std::uint32_t slot) const { return perm_[slot]; }
-  Point2* permanent_points(std::uint32_t slot) const { return perm_points_ + std::size_t{slot} * options_.skeleton_points; }
+  // Its skeleton points (point_count of them), submap frame, unpacked into the store's
+  // one scratch array: valid until the next call.
+  const Point2* permanent_points(std::uint32_t slot) const;
   CellPoint* permanent_obstacles(std::uint32_t slot) const {
     return perm_obstacles_ == nullptr ? nullptr : perm_obstacles_ + std::size_t{slot} * options_.obstacle_points;
   }
@@ -119,8 +143,10 @@ class SubmapStore {
     return perm_count_ > 0U ? perm_[perm_head_].level : first_live;
   }
   // A new newest permanent submap for live `level`'s submap `node`: its record, skeleton
-  // and obstacle points copied; the caller sets the frames. When the ring is full the
-  // oldest is forgotten first (*forgot = true). Returns its slot.
+  // and obstacle points copied (the skeleton points as cells of the submap's
+  // skeleton_grid: a point that is not a cell centre of it is kept at the nearest one,
+  // within the grid's 65536 cells a side); the caller sets the frames. When the ring is
+  // full the oldest is forgotten first (*forgot = true). Returns its slot.
   std::uint32_t make_permanent(std::uint32_t level, std::uint32_t node, bool* forgot);
 
   // The ring's head and count, for snapshots (state_io.h); the arrays travel with the arena.
@@ -140,7 +166,8 @@ class SubmapStore {
   CellPoint* obstacles_ = nullptr; // max_levels × nodes × obstacle_points (or null)
   SubmapLevel* levels_ = nullptr;  // max_levels
   PermanentSubmap* perm_ = nullptr;  // max_permanent
-  Point2* perm_points_ = nullptr;    // max_permanent × skeleton_points
+  SkeletonCell* perm_cells_ = nullptr;  // max_permanent × skeleton_points
+  Point2* perm_unpacked_ = nullptr;     // skeleton_points (permanent_points() scratch)
   CellPoint* perm_obstacles_ = nullptr;  // max_permanent × obstacle_points (or null)
   std::uint32_t perm_head_ = 0U;
   std::uint32_t perm_count_ = 0U;
