@@ -57,7 +57,11 @@ struct SdpOptions {
   PgsAccumulation accumulation = PgsAccumulation::kSum;
   double prior_error_m = 1.0;      // effective error of never-sampled edges (and of
                                    // never-evaluated particles when ranking)
-  std::uint32_t max_permanent_submaps = 512U;  // 1 .. capacity::kMaxPermanentSubmaps
+  // Submaps made permanent that stay in the loop-closure pose graph and the top level's
+  // matching (submap_store.h keeps each in about 2.7 KB: skeleton cells, obstacle points,
+  // frames); beyond, the oldest is forgotten (counted). 4096 submaps of a segment each
+  // are kilometres of route.
+  std::uint32_t max_permanent_submaps = 4096U;  // 1 .. capacity::kMaxPermanentSubmaps
   // [sdp] skeleton (free-space points per submap, computed at anchorage)
   std::uint32_t skeleton_points = 200U;  // per submap, 8 .. capacity::kMaxIcpPoints
   std::uint32_t skeleton_downsample = 2U;  // skeleton grid = map cells × this, 1 .. 8
