@@ -1,7 +1,9 @@
 // Timing of the top-level building blocks: ICP between two 500-point sets and
-// free-space skeleton extraction on a 200×200 patch, and the wide loop search
-// (correlative matching of two 300-point sets over ±3 m and ±6 m, ±0.35 rad). Prints
-// figures; build Release.
+// free-space skeleton extraction on a 200×200 patch, the wide loop search
+// (correlative matching of two 300-point sets over ±3 m and ±6 m, ±0.35 rad), and one
+// loop-closure adjustment of the pose graph at the default capacities (every permanent
+// submap and live level a node, every loop constraint used). Prints figures; build
+// Release.
 //   bench_top_level [repetitions]
 #include <chrono>
 #include <ctime>
@@ -9,7 +11,9 @@
 #include <cstdlib>
 #include <initializer_list>
 
+#include "loops/frame_graph.h"
 #include "sdpslam/core/arena.h"
+#include "sdpslam/core/sdp_options.h"
 #include "sdpslam/core/loops/correlative_matcher.h"
 #include "top/free_space_skeleton.h"
 #include "sdpslam/core/top/icp2d.h"
@@ -33,6 +37,67 @@ sdpslam::Point2 g_cm_source[300];
 double micros(Clock::duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
 // Process CPU time: less disturbed than wall time when the machine is shared.
 double cpu_us(std::clock_t ticks) { return 1e6 * static_cast<double>(ticks) / CLOCKS_PER_SEC; }
+
+// Frame graph at the default capacities: a chain of frames 2.5 m apart, round and round
+// a 60 m × 40 m block with a small heading bias per step, and loop constraints between
+// each frame and the frame one lap earlier (exact: the truth), as many as the
+// capacity holds.
+int bench_frame_graph(int reps) {
+  const sdpslam::SdpOptions defaults;
+  sdpslam::FrameGraphOptions o;
+  o.max_nodes = defaults.max_permanent_submaps + defaults.max_levels;
+  o.max_loops = defaults.max_loop_constraints;
+  o.iterations = defaults.graph_iterations;
+  o.robust_chi = defaults.loop_robust_chi;
+  static unsigned char buffer[16U << 20U];
+  sdpslam::Arena arena(buffer, sizeof buffer);
+  static sdpslam::FrameGraph graph;
+  if (!graph.init(o, arena)) {
+    std::fprintf(stderr, "bench_top_level: frame graph of %u nodes does not fit %zu bytes\n", o.max_nodes, sizeof buffer);
+    return 1;
+  }
+  constexpr std::uint32_t kLap = 80U;  // frames per lap of the 200 m block
+  const auto truth = [](std::uint32_t k) {
+    const double s = 2.5 * static_cast<double>(k % kLap);  // along the lap, m
+    const double pi = 3.14159265358979323846;
+    if (s < 60.0) return sdpslam::Pose2{s, 0.0, 0.0};
+    if (s < 100.0) return sdpslam::Pose2{60.0, s - 60.0, 0.5 * pi};
+    if (s < 160.0) return sdpslam::Pose2{160.0 - s, 40.0, pi};
+    return sdpslam::Pose2{0.0, 200.0 - s, -0.5 * pi};
+  };
+  const sdpslam::FrameInfo chain_info = sdpslam::FrameInfo::from_sigma(0.05, 0.01);
+  const sdpslam::FrameInfo loop_info = sdpslam::FrameInfo::from_sigma(defaults.loop_sigma_xy_m, defaults.loop_sigma_theta_rad);
+  double total_cpu_us = 0.0;
+  double worst_wall_us = 0.0;
+  std::uint32_t loops = 0U;
+  for (int rep = 0; rep < reps; ++rep) {
+    graph.clear();
+    sdpslam::Pose2 estimate{};
+    for (std::uint32_t k = 0; k < o.max_nodes; ++k) {
+      sdpslam::Pose2 step = k > 0U ? between(truth(k - 1U), truth(k)) : sdpslam::Pose2{};
+      if (k + kLap >= o.max_nodes) step.heading_rad += 0.002;  // the last lap's drift, not yet corrected
+      if (k > 0U) estimate = estimate.compose(step);
+      (void)graph.add_node(estimate, step, chain_info);
+    }
+    loops = 0U;
+    // Spread over the whole chain, newest first.
+    const std::uint32_t spacing = (o.max_nodes - kLap + o.max_loops - 1U) / o.max_loops;
+    for (std::uint32_t k = o.max_nodes - 1U; k >= kLap && loops < o.max_loops; k -= spacing) {
+      if (graph.add_loop(k - kLap, k, between(truth(k - kLap), truth(k)), loop_info)) ++loops;
+    }
+    const std::clock_t cpu0 = std::clock();
+    const auto t0 = Clock::now();
+    graph.optimise();
+    const double us = micros(Clock::now() - t0);
+    total_cpu_us += cpu_us(std::clock() - cpu0);
+    worst_wall_us = us > worst_wall_us ? us : worst_wall_us;
+  }
+  std::printf("frame_graph %u nodes, %u loops, %u Gauss-Newton steps: cpu mean %.1f ms, wall max %.1f ms per "
+              "adjustment (%d runs); objective %.1f -> %.1f\n",
+              graph.node_count(), loops, o.iterations, total_cpu_us / reps / 1000.0, worst_wall_us / 1000.0, reps,
+              graph.stats().last_chi2_before, graph.stats().last_chi2_after);
+  return 0;
+}
 
 // Four 80×80 rooms around a cross of 20-cell corridors, doors into the corridors.
 void office_patch() {
@@ -166,5 +231,6 @@ int main(int argc, char** argv) {
                   c.transform.heading_rad - moved.heading_rad);
     }
   }
-  return 0;
+  const int fg_reps = reps / 20 > 0 ? reps / 20 : 1;
+  return bench_frame_graph(fg_reps);
 }
