@@ -38,10 +38,11 @@ double micros(Clock::duration d) { return std::chrono::duration<double, std::mic
 // Process CPU time: less disturbed than wall time when the machine is shared.
 double cpu_us(std::clock_t ticks) { return 1e6 * static_cast<double>(ticks) / CLOCKS_PER_SEC; }
 
-// Frame graph at the default capacities: a chain of frames 2.5 m apart, round and round
-// a 60 m × 40 m block with a small heading bias per step, and loop constraints between
-// each frame and the frame one lap earlier (exact: the truth), as many as the
-// capacity holds.
+// Frame graph at SdpOptions' default capacities: a chain of frames 2.5 m apart, round
+// and round a 60 m × 40 m block, whose last lap has a heading bias per step that no
+// adjustment has corrected yet (earlier laps were adjusted when their loops came), and
+// loop constraints between frames and the frame one lap earlier (exact: the truth),
+// spread over the chain, as many as the capacity holds.
 int bench_frame_graph(int reps) {
   const sdpslam::SdpOptions defaults;
   sdpslam::FrameGraphOptions o;
