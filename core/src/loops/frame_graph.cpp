@@ -319,6 +319,8 @@ void FrameGraph::optimise() {
     return s;
   };
   stats_.last_chi2_before = total_chi2();
+  double current = stats_.last_chi2_before;
+  constexpr std::uint32_t kHalvings = 8U;
   for (std::uint32_t it = 0; it < options_.iterations; ++it) {
     for (std::uint32_t k = 1; k < n_; ++k) linearise(seq_[k], lin_[k]);
     for (std::uint32_t q = 0; q < loops_; ++q) {
@@ -370,12 +372,44 @@ void FrameGraph::optimise() {
       rz = rz_new;
       for (std::size_t k = 3; k < dim; ++k) p[k] = z[k] + beta * p[k];
     }
-    double step = 0.0;
+    // Step acceptance (backtracking): Gauss-Newton's step minimises the linearised
+    // objective, which far from the solution (headings wrong by radians) can raise the
+    // true one. A step is taken only if the objective does not rise; otherwise it is
+    // halved, up to kHalvings times, and if none helps the poses stay and the solve
+    // stops (counted in stats_.refused_steps). The poses before the step wait in z.
+    double* saved = z;
     for (std::uint32_t k = 1; k < n_; ++k) {
-      pose_[k].x_m += x[3U * k];
-      pose_[k].y_m += x[3U * k + 1U];
-      pose_[k].heading_rad = normalize_angle_rad(pose_[k].heading_rad + x[3U * k + 2U]);
-      step += x[3U * k] * x[3U * k] + x[3U * k + 1U] * x[3U * k + 1U] + x[3U * k + 2U] * x[3U * k + 2U];
+      saved[3U * k] = pose_[k].x_m;
+      saved[3U * k + 1U] = pose_[k].y_m;
+      saved[3U * k + 2U] = pose_[k].heading_rad;
+    }
+    double scale = 1.0;
+    double step = 0.0;
+    bool accepted = false;
+    for (std::uint32_t h = 0; h <= kHalvings; ++h, scale *= 0.5) {
+      step = 0.0;
+      for (std::uint32_t k = 1; k < n_; ++k) {
+        const double dx = scale * x[3U * k], dy = scale * x[3U * k + 1U], dt = scale * x[3U * k + 2U];
+        pose_[k].x_m = saved[3U * k] + dx;
+        pose_[k].y_m = saved[3U * k + 1U] + dy;
+        pose_[k].heading_rad = normalize_angle_rad(saved[3U * k + 2U] + dt);
+        step += dx * dx + dy * dy + dt * dt;
+      }
+      const double after = total_chi2();
+      if (after <= current) {
+        current = after;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      for (std::uint32_t k = 1; k < n_; ++k) {
+        pose_[k].x_m = saved[3U * k];
+        pose_[k].y_m = saved[3U * k + 1U];
+        pose_[k].heading_rad = saved[3U * k + 2U];
+      }
+      ++stats_.refused_steps;
+      break;
     }
     if (step < 1e-14) break;
   }

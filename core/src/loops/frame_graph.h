@@ -20,10 +20,12 @@
 // as 1/χ: a false loop kept most of an inlier's pull). A loop verified before it was
 // added may go without a kernel (kNoKernel).
 //
-// Solver: Gauss-Newton on the poses (additive update of x, y, θ). Each step solves
-// H Δ = -b by preconditioned conjugate gradients; H is never formed, H·v is summed over
-// the constraints. The preconditioner is H without the loop constraints' off-diagonal
-// blocks: block-tridiagonal (the chain), factorised exactly in O(n) (block LDLᵀ), so CG
+// Solver: Gauss-Newton on the poses (additive update of x, y, θ), with step acceptance:
+// a step that raises the objective is halved until it does not, or refused (the poses
+// stay and the solve ends), so a solve never leaves the graph worse than it found it.
+// Each step solves H Δ = -b by preconditioned conjugate gradients; H is never formed,
+// H·v is summed over the constraints. The preconditioner is H without the loop
+// constraints' off-diagonal blocks: block-tridiagonal (the chain), factorised exactly in O(n) (block LDLᵀ), so CG
 // only has to account for the loops and converges in a few iterations.
 // Cost per step O(n + loops) per CG iteration; memory fixed at init. Deterministic
 // (det:: trigonometry, fixed iteration counts and order).
@@ -84,6 +86,7 @@ struct FrameGraphStats {
   double last_chi2_before = 0.0;     // objective (chain χ² + the loops' kernel cost) before / after the last solve
   double last_chi2_after = 0.0;
   std::uint32_t last_downweighted = 0U;  // loops with kernel weight < 0.5 at the end
+  std::uint64_t refused_steps = 0U;      // Gauss-Newton steps that raised the objective even when halved
 };
 
 class FrameGraph {

@@ -29,6 +29,7 @@ struct LoopClosureStats {
   std::uint64_t loop_information_unmeasured = 0U;      // loop matches whose direction information failed
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
+  std::uint64_t frame_steps_refused = 0U;   // pose-graph solves ended by a step that raised the objective
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
   std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_min_score
   std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
