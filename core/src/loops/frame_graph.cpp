@@ -321,6 +321,7 @@ void FrameGraph::optimise() {
   stats_.last_chi2_before = total_chi2();
   double current = stats_.last_chi2_before;
   constexpr std::uint32_t kHalvings = 8U;
+  constexpr double kRounding = 1e-9;  // relative; double rounding over the sums is ~1e-15
   for (std::uint32_t it = 0; it < options_.iterations; ++it) {
     for (std::uint32_t k = 1; k < n_; ++k) linearise(seq_[k], lin_[k]);
     for (std::uint32_t q = 0; q < loops_; ++q) {
@@ -376,7 +377,9 @@ void FrameGraph::optimise() {
     // objective, which far from the solution (headings wrong by radians) can raise the
     // true one. A step is taken only if the objective does not rise; otherwise it is
     // halved, up to kHalvings times, and if none helps the poses stay and the solve
-    // stops (counted in stats_.refused_steps). The poses before the step wait in z.
+    // stops (counted in stats_.refused_steps). At convergence the objective moves by
+    // rounding only, either way: a rise within kRounding of it is no rise. The poses
+    // before the step wait in z.
     double* saved = z;
     for (std::uint32_t k = 1; k < n_; ++k) {
       saved[3U * k] = pose_[k].x_m;
@@ -396,7 +399,7 @@ void FrameGraph::optimise() {
         step += dx * dx + dy * dy + dt * dt;
       }
       const double after = total_chi2();
-      if (after <= current) {
+      if (after <= current * (1.0 + kRounding)) {
         current = after;
         accepted = true;
         break;
