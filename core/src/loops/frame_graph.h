@@ -25,10 +25,11 @@
 // stay and the solve ends), so a solve never leaves the graph worse than it found it.
 // Each step solves H Δ = -b by preconditioned conjugate gradients; H is never formed,
 // H·v is summed over the constraints. The preconditioner is H without the loop
-// constraints' off-diagonal blocks: block-tridiagonal (the chain), factorised exactly in O(n) (block LDLᵀ), so CG
-// only has to account for the loops and converges in a few iterations.
-// Cost per step O(n + loops) per CG iteration; memory fixed at init. Deterministic
-// (det:: trigonometry, fixed iteration counts and order).
+// constraints' off-diagonal blocks: block-tridiagonal (the chain), factorised exactly
+// in O(n) (block LDLᵀ), so CG only has to account for the loops and converges in a few
+// iterations. Cost per step O(n + loops) per CG iteration, plus one evaluation of the
+// objective per trial step; memory fixed at init. Deterministic (det:: trigonometry,
+// fixed iteration counts and order).
 #include <cstddef>
 #include <cstdint>
 #include <limits>
