@@ -38,8 +38,9 @@ struct Rig {
   FrameGraph graph;
   std::vector<Pose2> truth = square_truth();
   // Sequential measurements with a heading bias (rad per step): the chain drifts.
-  void build_drifting_chain(double bias_rad = 0.02) {
-    graph.clear();
+  void build_drifting_chain(double bias_rad = 0.02) { build_drifting_chain(graph, bias_rad); }
+  void build_drifting_chain(FrameGraph& g, double bias_rad) {
+    g.clear();
     Pose2 est = truth[0];
     for (std::size_t k = 0; k < truth.size(); ++k) {
       Pose2 z;
@@ -48,7 +49,7 @@ struct Rig {
         z.heading_rad += bias_rad;
         est = est.compose(z);
       }
-      CHECK_TRUE(graph.add_node(k == 0 ? truth[0] : est, z, FrameInfo::from_sigma(0.1, 0.02)));
+      CHECK_TRUE(g.add_node(k == 0 ? truth[0] : est, z, FrameInfo::from_sigma(0.1, 0.02)));
     }
   }
 };
@@ -338,17 +339,7 @@ TEST(FrameGraph, a_converged_solve_refuses_no_step_for_rounding) {
   CHECK_TRUE(g.init(o, rig->arena));
   const std::vector<Pose2>& t = rig->truth;
   for (const double bias_rad : {0.005, 0.01, 0.02, 0.04}) {
-    g.clear();
-    Pose2 est = t[0];
-    for (std::size_t k = 0; k < t.size(); ++k) {
-      Pose2 z;
-      if (k > 0) {
-        z = between(t[k - 1], t[k]);
-        z.heading_rad += bias_rad;
-        est = est.compose(z);
-      }
-      CHECK_TRUE(g.add_node(est, z, FrameInfo::from_sigma(0.1, 0.02)));
-    }
+    rig->build_drifting_chain(g, bias_rad);
     for (std::uint32_t q = 0; q < 8U; ++q) {
       const std::uint32_t i = q, j = q + 8U;
       Pose2 z = between(t[i], t[j]);
