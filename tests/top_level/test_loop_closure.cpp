@@ -4,7 +4,8 @@
 // then moves the drifted frame onto it; a revisit beyond the chain's drift is refused;
 // one that needs more than half the search window is searched again around its peak,
 // and kept only if no alias shows there; the top level's matches are
-// refined and kept one per pair of levels, the best residual winning; a full store makes
+// refined and kept one per pair of levels, the best residual winning, but never over a
+// verified peak they disagree with; a full store makes
 // room with a record whose levels are gone; nothing is searched without a window.
 #include <cmath>
 #include <cstdio>
@@ -342,6 +343,66 @@ TEST(LoopClosure, refined_matches_are_kept_one_per_pair_of_levels) {
   // Too few points: not even tried.
   rig->loops.refine(1U, a.data(), 10U, 3U, b.data(), n, z, z);
   CHECK_EQUAL(3U, rig->stats.loop_refinements);
+}
+
+// A pair the wide search verified keeps its verified estimate against a top-level ICP
+// match of the same pair that lies farther than a coarse block of the search's grid from
+// it (a rival optimum, as a match that slid along a corridor is), however low that
+// match's residual; an ICP match within the block is the same loop refined and replaces
+// it, still verified. The other way round, a verified peak replaces a rival ICP record
+// whatever the residuals.
+TEST(LoopClosure, a_verified_loop_is_not_displaced_by_a_rival_icp_match) {
+  const Pose2 truth2{3.0, -1.0, 0.4};
+  const Pose2 rival2 = truth2.compose(Pose2{1.0, 0.0, 0.0});
+  const std::vector<Point2> a = room();
+  const auto n = static_cast<std::uint32_t>(a.size());
+  const std::vector<Point2> exact = seen_from(a, Pose2{}, truth2);
+  std::vector<Point2> jittered = exact;  // a residual of about 3 cm
+  for (std::size_t k = 0; k < jittered.size(); ++k) jittered[k].x_m += (k % 2 == 0 ? 0.03 : -0.03);
+  const std::vector<Point2> slid = seen_from(a, Pose2{}, rival2);  // fits perfectly at rival2
+  auto build = [&] {
+    Owner& o = rig->owner;
+    o.levels.push_back({Pose2{}, a});
+    o.levels.push_back({Pose2{1.5, 20.0, 0.2}, corridor(0.0)});
+    o.levels.push_back({truth2.compose(Pose2{2.0, 0.0, 0.1}), jittered});
+    CHECK_TRUE(rig->init());
+  };
+  build();
+  rig->search_all();
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  check_searched_record(rig->loops.record(0), 0U, 2U, truth2);
+  const double verified_error = rig->loops.record(0).error_m;
+  CHECK_TRUE(verified_error > 0.01);
+  // The rival: 1 m from the verified peak, residual near 0. Refused and counted.
+  rig->loops.refine(0U, a.data(), n, 2U, slid.data(), n, rival2, rival2);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  check_searched_record(rig->loops.record(0), 0U, 2U, truth2);
+  DOUBLES_EQUAL(verified_error, rig->loops.record(0).error_m, 0.0);
+  CHECK_EQUAL(1U, rig->stats.loop_rivals_refused);
+  // The same loop, refined on better points: it replaces the record and stays verified.
+  rig->loops.refine(0U, a.data(), n, 2U, exact.data(), n, truth2, truth2);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  check_searched_record(rig->loops.record(0), 0U, 2U, truth2);
+  CHECK_TRUE(rig->loops.record(0).error_m < verified_error);
+  CHECK_EQUAL(1U, rig->stats.loop_rivals_refused);
+
+  // The rival recorded while the pair's search runs (in slices over scans): the
+  // verified peak replaces it when the search ends.
+  delete rig;
+  rig = new Rig();
+  rig->options.loop_search_reads_per_scan = 10000U;
+  build();
+  for (int k = 0; k < 10 && rig->stats.loop_searches == 0U; ++k) rig->loops.search_step();  // the pair's search starts
+  CHECK_EQUAL(1U, rig->stats.loop_searches);
+  CHECK_EQUAL(0U, rig->stats.loop_search_closed);
+  rig->loops.refine(0U, a.data(), n, 2U, slid.data(), n, rival2, rival2);
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  CHECK_FALSE(rig->loops.record(0).searched);
+  CHECK_TRUE(rig->loops.record(0).error_m < verified_error);
+  rig->search_all();
+  CHECK_EQUAL(1U, rig->loops.record_count());
+  check_searched_record(rig->loops.record(0), 0U, 2U, truth2);
+  CHECK_EQUAL(0U, rig->stats.loop_rivals_refused);
 }
 
 TEST(LoopClosure, a_full_store_makes_room_with_a_record_whose_levels_are_gone) {

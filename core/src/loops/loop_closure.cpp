@@ -129,14 +129,31 @@ LoopClosure::Record LoopClosure::matched(std::uint32_t older_level, const Point2
   return r;
 }
 
-// One record per pair of levels (the lowest residual wins). When the store is full a
-// dead record makes room, else the worst record if the new one is better.
+// One record per pair of levels. Two estimates of the same loop (within a coarse block
+// of the search's grid of each other: the reach of the search's ICP polish) keep the
+// lower residual, verified if either was. Estimates farther apart are rival optima of
+// the pair: the wide search's exact, unambiguous peak (verified) wins over the top
+// level's ICP, whatever their residuals (a match that slid along a corridor fits its
+// walls as well as the true one does); between two of a kind the lower residual wins.
+// When the store is full a dead record makes room, else the worst record if the new
+// one is better.
 void LoopClosure::record(const Record& r) {
   std::uint32_t worst = count_;
   std::uint32_t dead = count_;
   for (std::uint32_t k = 0; k < count_; ++k) {
     Record& q = records_[k];
     if (q.older_level == r.older_level && q.newer_level == r.newer_level) {
+      const double dx = r.z.x_m - q.z.x_m;
+      const double dy = r.z.y_m - q.z.y_m;
+      const double block = static_cast<double>(kSearchCoarseCells) * geometry_.resolution_m;
+      if (q.searched != r.searched && dx * dx + dy * dy > block * block) {
+        if (r.searched) {
+          q = r;
+        } else if (r.error_m < q.error_m) {
+          ++stats_->loop_rivals_refused;  // it would have won on its residual
+        }
+        return;
+      }
       if (r.error_m < q.error_m) {
         const bool searched = q.searched || r.searched;
         q = r;

@@ -10,8 +10,10 @@
 // anchorage) by refine(); a refined match with a small residual and a bounded correction
 // is kept as a constraint between the two LEVELS' frames (all submaps of a level share
 // its frame: the bottom particles restarted at one pose), one per pair of levels (the
-// lowest residual wins; a full store makes room with a record whose levels are gone,
-// else with its worst record). A constraint is only as certain as its match in each
+// lowest residual wins, except that the wide search's verified peak is never displaced
+// by an ICP match farther than a coarse search block from it, and displaces such a
+// match itself; a full store makes room with a record whose levels are gone, else with
+// its worst record). A constraint is only as certain as its match in each
 // direction: the refined pairing's wall normals (Icp2d::direction_information) give it
 // little information along a corridor it could slide in (FrameInfo::from_directions).
 //

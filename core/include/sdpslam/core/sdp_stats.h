@@ -23,6 +23,7 @@ struct LoopClosureStats {
   std::uint64_t loop_refinements = 0U;      // obstacle-point ICP runs
   std::uint64_t loop_records_added = 0U;    // ICP matches kept as loop constraints
   std::uint64_t loop_records_dropped = 0U;  // kept matches that found no room (store full)
+  std::uint64_t loop_rivals_refused = 0U;   // ICP matches of a verified pair, far from its peak, kept out despite a lower residual
   std::uint64_t loop_constraints_used = 0U; // in the last adjustment
   std::uint64_t loop_downweighted = 0U;     // of those, weight < 0.5 after it (disagreeing)
   std::uint64_t loop_constraints_weak_direction = 0U;  // loop matches weak along a direction (corridors)

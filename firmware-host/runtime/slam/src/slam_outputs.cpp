@@ -296,6 +296,7 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                         {"refinements", st.loop_refinements},
                         {"added", st.loop_records_added},
                         {"dropped", st.loop_records_dropped},
+                        {"rivals_refused", st.loop_rivals_refused},
                         {"used_last", st.loop_constraints_used},
                         {"downweighted_last", st.loop_downweighted},
                         {"weak_direction", st.loop_constraints_weak_direction},
