@@ -219,6 +219,54 @@ TEST(Relations, relations_by_span_split_the_error_into_local_steps_and_revisits)
   LONGS_EQUAL(2, none.size());
   LONGS_EQUAL(0, none[0].translation_m.count + none[1].translation_m.count);
   DOUBLES_EQUAL(0.0, none[0].share + none[1].share, 0.0);
+  CHECK_FALSE(none[0].scale_measured);
+  DOUBLES_EQUAL(0.0, none[0].scale_error, 0.0);
+}
+
+TEST(Relations, relations_by_span_measure_steps_that_come_out_short_whatever_the_loops_hold) {
+  // The truth winds (truth()); the estimate's steps are 2 % short (each step scaled by
+  // 0.98 in its own frame), except that it is put back on the truth every 10 s, as loop
+  // closures would. Local relations (1 s) see the shrink exactly; relations of 10 s
+  // between the poses put back see none; a relation without motion says nothing.
+  const auto gt = truth(301);
+  std::vector<StampedPose> est = gt;
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    const Pose2 step = sdpslam::between(gt[i - 1].pose, gt[i].pose);
+    est[i].pose = i % 100 == 0 ? gt[i].pose
+                               : est[i - 1].pose.compose(Pose2{0.98 * step.x_m, 0.98 * step.y_m, step.heading_rad});
+  }
+  std::vector<Relation> rel;
+  const auto add = [&](std::size_t i, std::size_t j) {
+    rel.push_back(Relation{gt[i].stamp_us, gt[j].stamp_us, sdpslam::between(gt[i].pose, gt[j].pose),
+                           static_cast<std::int64_t>(rel.size() + 1)});
+  };
+  for (std::size_t k = 0; k < 290; k += 7) {
+    if (k % 100U + 10U < 100U) add(k, k + 10);  // 1 s, within one stretch between resets
+  }
+  add(0, 100);
+  add(100, 200);
+  add(0, 300);
+  rel.push_back(Relation{gt[5].stamp_us, gt[5].stamp_us, Pose2{}, static_cast<std::int64_t>(rel.size() + 1)});
+  const auto res = sdpslam::eval::evaluate_relations(rel, est);
+  const auto c = sdpslam::eval::relations_by_span(res, {2000000});
+  LONGS_EQUAL(2, c.size());
+  CHECK_TRUE(c[0].scale_measured);
+  CHECK_TRUE(c[1].scale_measured);
+  DOUBLES_EQUAL(-0.02, c[0].scale_error, 1e-9);
+  DOUBLES_EQUAL(0.0, c[1].scale_error, 1e-12);
+  // Without the resets every class is 2 % short.
+  std::vector<StampedPose> shrunk = gt;
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    const Pose2 step = sdpslam::between(gt[i - 1].pose, gt[i].pose);
+    shrunk[i].pose = shrunk[i - 1].pose.compose(Pose2{0.98 * step.x_m, 0.98 * step.y_m, step.heading_rad});
+  }
+  const auto all = sdpslam::eval::relations_by_span(sdpslam::eval::evaluate_relations(rel, shrunk), {2000000});
+  DOUBLES_EQUAL(-0.02, all[0].scale_error, 1e-9);
+  DOUBLES_EQUAL(-0.02, all[1].scale_error, 1e-9);
+  // Only a relation without motion: nothing measured.
+  const std::vector<Relation> still{rel.back()};
+  const auto s = sdpslam::eval::relations_by_span(sdpslam::eval::evaluate_relations(still, est), {2000000});
+  CHECK_FALSE(s[0].scale_measured);
 }
 
 TEST_GROUP(FillWithOdometry){};

@@ -3,7 +3,9 @@
 # world, each run once per seed with the same options, so that a change is judged by its
 # mean and its worst seed rather than by one lucky run.
 #   - logs: `sdpslam run LOG --seed S`, then the relations metric (`sdpslam evaluate
-#     --relations`, mean absolute translational error, m);
+#     --relations`, mean absolute translational error, m), and the along-track scale
+#     error of the relations under 2 s apart (evaluate's local span class: whether the
+#     steps come out shorter or longer than the true ones, whatever the loops did);
 #   - worlds: `sdpslam simulate --world NAME --seed S` (the seed also draws the sensor
 #     noise, so each seed is a different simulated run), `sdpslam run --seed S` on it, then
 #     the absolute trajectory error against the simulator's ground truth (ATE RMSE after
@@ -116,10 +118,16 @@ refusals = str(sum(n for _, n in kinds)) if st else "NA"
 nonzero = ",".join("%s=%d" % kn for kn in kinds if kn[1]) or "-"
 obs = pools.get("observations", {})
 rpe = (ev or {}).get("rpe") or {}
+scale = get(rpe, "scale_error")
+if kind == "log":
+    # The local span class (relations under 2 s apart) comes first.
+    spans = ((ev or {}).get("relations") or {}).get("by_span") or [{}]
+    local = spans[0].get("scale_error")
+    scale = "NA" if local is None else repr(local)
 used = ((ev or {}).get("loops") or {}).get("used") or {}
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
                  get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
-                 get(rpe, "mean_m"), get(rpe, "scale_error"), get(used, "count"), get(used, "wrong"),
+                 get(rpe, "mean_m"), scale, get(used, "count"), get(used, "wrong"),
                  get(obs, "writes_shortened"), get(obs, "shortest_write_reach_m"), get(t, "scans_cpu_over_100ms")]))
 EOF
   printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' \
@@ -235,7 +243,9 @@ for (kind, name), rs in groups.items():
     short = [(n, num(r["shortest_write_reach_m"])) for r in rs for n in [num(r["writes_shortened"])] if n]
     if short:
         refs += "; %d writes shortened (to %.2f m)" % (sum(n for n, _ in short), min(m for _, m in short))
-    # The relative error needs a ground-truth trajectory: the worlds have one, the logs not.
+    # The relative error needs a ground-truth trajectory: the worlds have one, the logs
+    # not. The along-track scale: the worlds' per 10 m of path, the logs' over their
+    # relations under 2 s apart.
     rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
     drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
     along = "-" if not scale else "%+.2f" % (100.0 * sum(scale) / len(scale))

@@ -228,14 +228,17 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
     std::string range = c.to_us < 0 ? format_seconds(from_s) + " and over"
                         : c.from_us == 0 ? "under " + format_seconds(to_s)
                                          : format_seconds(from_s) + " to " + format_seconds(to_s);
-    std::printf("  span        %s: %zu relations, mean %.3f m, max %.3f m (%.0f %% of the error)\n", range.c_str(),
+    std::printf("  span        %s: %zu relations, mean %.3f m, max %.3f m (%.0f %% of the error)", range.c_str(),
                 c.translation_m.count, c.translation_m.mean, c.translation_m.max, 100.0 * c.share);
+    if (c.scale_measured) std::printf(", along-track scale %+.3f %%", 100.0 * c.scale_error);
+    std::printf("\n");
     by_span.push_back(io::Json{{"from_s", from_s},
                                {"to_s", c.to_us < 0 ? io::Json(nullptr) : io::Json(to_s)},
                                {"count", c.translation_m.count},
                                {"translation_mean_m", c.translation_m.mean},
                                {"translation_max_m", c.translation_m.max},
-                               {"share", c.share}});
+                               {"share", c.share},
+                               {"scale_error", c.scale_measured ? io::Json(c.scale_error) : io::Json(nullptr)}});
   }
 
   (*json)["relations"] = {{"file", a.relations_path},

@@ -199,6 +199,8 @@ std::vector<std::size_t> worst_relations(const RelationsResult& result, std::siz
 
 std::vector<SpanClass> relations_by_span(const RelationsResult& result, const std::vector<std::int64_t>& edges_us) {
   std::vector<std::vector<double>> errors(edges_us.size() + 1U);
+  std::vector<double> along(errors.size(), 0.0);   // Σ (t_est − t_true)·t_true
+  std::vector<double> length2(errors.size(), 0.0);  // Σ |t_true|²
   double total = 0.0;
   for (const RelationResult& r : result.per_relation) {
     const std::int64_t span = r.relation.t2_us > r.relation.t1_us ? r.relation.t2_us - r.relation.t1_us
@@ -207,6 +209,11 @@ std::vector<SpanClass> relations_by_span(const RelationsResult& result, const st
     while (k < edges_us.size() && span >= edges_us[k]) ++k;
     errors[k].push_back(r.translation_error_m);
     total += r.translation_error_m;
+    // E = δ_est ⊕ δ_true⁻¹ (Eq. 2), so δ_est = E ⊕ δ_true.
+    const Pose2& truth = r.relation.expected;
+    const Pose2 estimate = r.error.compose(truth);
+    along[k] += (estimate.x_m - truth.x_m) * truth.x_m + (estimate.y_m - truth.y_m) * truth.y_m;
+    length2[k] += truth.x_m * truth.x_m + truth.y_m * truth.y_m;
   }
   std::vector<SpanClass> out(errors.size());
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -216,6 +223,8 @@ std::vector<SpanClass> relations_by_span(const RelationsResult& result, const st
     double sum = 0.0;
     for (double e : errors[k]) sum += e;
     out[k].share = total > 0.0 ? sum / total : 0.0;
+    out[k].scale_measured = length2[k] > 0.0;
+    out[k].scale_error = out[k].scale_measured ? along[k] / length2[k] : 0.0;
   }
   return out;
 }

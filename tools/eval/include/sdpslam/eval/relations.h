@@ -98,11 +98,20 @@ std::vector<std::size_t> worst_relations(const RelationsResult& result, std::siz
 // the spans in [edges_us[k − 1], edges_us[k]) (edges ascending; class 0 from 0, the last
 // to no end): edges.size() + 1 classes, each with its translational error and its share
 // of the sum of all used relations' translational errors (0 when that sum is 0).
+// Each class also says whether the estimate's displacements come out shorter or longer
+// than the true ones: the along-track scale error, the least-squares fit of the
+// estimated displacement's error onto the true displacement, Σ (t_est − t_true)·t_true /
+// Σ |t_true|² over the class (−0.01: 1 % short; weighted by length², so relations that
+// barely move, whose direction says little, count little). A map whose steps come out
+// short everywhere shows it in the local class even when its loops hold the whole in
+// place. 0 with scale_measured false when no relation of the class moves.
 struct SpanClass {
   std::int64_t from_us = 0;
   std::int64_t to_us = -1;  // -1: no upper end
   ErrorStats translation_m;
   double share = 0.0;
+  double scale_error = 0.0;
+  bool scale_measured = false;
 };
 std::vector<SpanClass> relations_by_span(const RelationsResult& result, const std::vector<std::int64_t>& edges_us);
 
