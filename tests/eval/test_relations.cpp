@@ -229,12 +229,18 @@ TEST(Relations, relations_by_span_measure_steps_that_come_out_short_whatever_the
   // closures would. Local relations (1 s) see the shrink exactly; relations of 10 s
   // between the poses put back see none; a relation without motion says nothing.
   const auto gt = truth(301);
-  std::vector<StampedPose> est = gt;
-  for (std::size_t i = 1; i < gt.size(); ++i) {
-    const Pose2 step = sdpslam::between(gt[i - 1].pose, gt[i].pose);
-    est[i].pose = i % 100 == 0 ? gt[i].pose
-                               : est[i - 1].pose.compose(Pose2{0.98 * step.x_m, 0.98 * step.y_m, step.heading_rad});
-  }
+  // Every step 2 % short; with `reset`, every 100th pose put back on the truth.
+  const auto shortened = [&gt](bool reset) {
+    std::vector<StampedPose> p = gt;
+    for (std::size_t i = 1; i < gt.size(); ++i) {
+      const Pose2 step = sdpslam::between(gt[i - 1].pose, gt[i].pose);
+      p[i].pose = reset && i % 100 == 0
+                      ? gt[i].pose
+                      : p[i - 1].pose.compose(Pose2{0.98 * step.x_m, 0.98 * step.y_m, step.heading_rad});
+    }
+    return p;
+  };
+  const std::vector<StampedPose> est = shortened(true);
   std::vector<Relation> rel;
   const auto add = [&](std::size_t i, std::size_t j) {
     rel.push_back(Relation{gt[i].stamp_us, gt[j].stamp_us, sdpslam::between(gt[i].pose, gt[j].pose),
@@ -255,12 +261,8 @@ TEST(Relations, relations_by_span_measure_steps_that_come_out_short_whatever_the
   DOUBLES_EQUAL(-0.02, c[0].scale_error, 1e-9);
   DOUBLES_EQUAL(0.0, c[1].scale_error, 1e-12);
   // Without the resets every class is 2 % short.
-  std::vector<StampedPose> shrunk = gt;
-  for (std::size_t i = 1; i < gt.size(); ++i) {
-    const Pose2 step = sdpslam::between(gt[i - 1].pose, gt[i].pose);
-    shrunk[i].pose = shrunk[i - 1].pose.compose(Pose2{0.98 * step.x_m, 0.98 * step.y_m, step.heading_rad});
-  }
-  const auto all = sdpslam::eval::relations_by_span(sdpslam::eval::evaluate_relations(rel, shrunk), {2000000});
+  const auto all =
+      sdpslam::eval::relations_by_span(sdpslam::eval::evaluate_relations(rel, shortened(false)), {2000000});
   DOUBLES_EQUAL(-0.02, all[0].scale_error, 1e-9);
   DOUBLES_EQUAL(-0.02, all[1].scale_error, 1e-9);
   // Only a relation without motion: nothing measured.
