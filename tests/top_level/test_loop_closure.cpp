@@ -6,7 +6,8 @@
 // and kept only if no alias shows there; the top level's matches are
 // refined and kept one per pair of levels, the best residual winning, but never over a
 // verified peak they disagree with; a full store makes
-// room with a record whose levels are gone; nothing is searched without a window.
+// room with a record whose levels are gone; overlapping submaps beyond the candidate cap
+// are counted; nothing is searched without a window.
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -308,6 +309,31 @@ TEST(LoopClosure, a_submap_beyond_the_base_window_but_within_the_drift_bound_is_
   CHECK_EQUAL(1U, rig->stats.loop_search_recentred_closed);
   CHECK_EQUAL(1U, rig->loops.record_count());
   check_searched_record(rig->loops.record(0), 0U, 3U, truth3);
+}
+
+// Four levels see the same room. Level 2 has one older candidate (level 0); level 3 has
+// two (levels 0 and 1; the adjacent level 2 is never one). With loop_search_candidates =
+// 1, level 3's second candidate is left unsearched and counted; with 2 every pair is
+// searched and nothing is counted. Either way each overlapping pair is searched or
+// counted, never silently skipped.
+TEST(LoopClosure, overlapping_submaps_beyond_the_candidate_cap_are_counted) {
+  auto build = [&](std::uint32_t cap) {
+    Owner& o = rig->owner;
+    for (int k = 0; k < 4; ++k) o.levels.push_back({Pose2{}, room()});
+    rig->options.loop_search_candidates = cap;
+    CHECK_TRUE(rig->init());
+    rig->search_all();
+  };
+  build(1U);
+  CHECK_EQUAL(2U, rig->stats.loop_searches);
+  CHECK_EQUAL(1U, rig->stats.loop_search_candidates_dropped);
+  CHECK_EQUAL(2U, rig->stats.loop_search_closed);
+  delete rig;
+  rig = new Rig();
+  build(2U);
+  CHECK_EQUAL(3U, rig->stats.loop_searches);
+  CHECK_EQUAL(0U, rig->stats.loop_search_candidates_dropped);
+  CHECK_EQUAL(3U, rig->stats.loop_search_closed);
 }
 
 // The top level's skeleton match, refined on obstacle points: one record per pair of

@@ -235,7 +235,8 @@ void LoopClosure::search_step() {
 // best combination overlap the newer's box grown by the window the pair would be
 // searched with (search_window_m: the drift bound between the two, within
 // [loop_search_window_m, loop_search_max_window_m]), so that every submap the search
-// could recover is a candidate; the loop_search_candidates largest overlaps.
+// could recover is a candidate; the loop_search_candidates largest overlaps. The others
+// are not searched for this level, and are counted (loop_search_candidates_dropped).
 void LoopClosure::search_collect(std::uint32_t newer) {
   search_count_ = 0U;
   search_cursor_ = 0U;
@@ -268,6 +269,7 @@ void LoopClosure::search_collect(std::uint32_t newer) {
     const double a = box_overlap_m2(gb, grown);
     if (a < options_.min_overlap_m2 || !(a > 0.0)) continue;
     std::uint32_t pos = search_count_ < kmax ? search_count_ : kmax;
+    if (pos == kmax) ++stats_->loop_search_candidates_dropped;  // this one or the smallest so far
     if (pos == kmax && !(a > area[kmax - 1U])) continue;
     if (pos == kmax) pos = kmax - 1U;
     while (pos > 0U && area[pos - 1U] < a) {

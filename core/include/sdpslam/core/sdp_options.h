@@ -201,7 +201,8 @@ struct SdpOptions {
   // it), and the one that the drifted chain puts nearest is often not the one the robot
   // is really in; each candidate is a compute budget (one exact search, spread over
   // scans by loop_search_reads_per_scan), and each is one more chance for a false peak,
-  // which the verification above has to catch.
+  // which the verification above has to catch. Overlapping submaps beyond this many are
+  // not searched for that level; they are counted (loop_search_candidates_dropped).
   std::uint32_t loop_search_candidates = 8U;   // 1 .. kMaxLoopSearchCandidates
   // Grid reads of the search per process() call (about 1 ns each): a search is spread
   // over as many calls as it needs, whole headings at a time (at least one per call).
