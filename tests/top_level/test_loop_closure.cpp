@@ -7,7 +7,7 @@
 // refined and kept one per pair of levels, the best residual winning, but never over a
 // verified peak they disagree with; a full store makes
 // room with a record whose levels are gone; overlapping submaps beyond the candidate cap
-// are counted; nothing is searched without a window.
+// are counted; the newest level is searched first; nothing is searched without a window.
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -62,7 +62,8 @@ std::vector<Point2> corridor(double x0_m) {
 }
 
 // The owner: levels 0 .. n-1, all held and live; each with its frame (as the chain
-// placed it), its obstacle points and its box.
+// placed it), its obstacle points and its box. The first `arrived` of them exist so far
+// (segmentation adds levels one at a time).
 struct Owner final : LoopSubmaps {
   struct Level {
     Pose2 frame;
@@ -70,16 +71,19 @@ struct Owner final : LoopSubmaps {
   };
   std::vector<Level> levels;
   std::uint32_t first_held = 0U;
+  std::size_t arrived = SIZE_MAX;
   int verified = 0;
   bool node_index(std::uint32_t level, std::uint32_t* index) const override {
-    if (level < first_held || level >= levels.size()) return false;
+    if (level < first_held || level >= level_end()) return false;
     *index = level - first_held;
     return true;
   }
-  std::uint32_t node_count() const override { return static_cast<std::uint32_t>(levels.size()) - first_held; }
+  std::uint32_t node_count() const override { return level_end() - first_held; }
   std::uint32_t first_held_level() const override { return first_held; }
   std::uint32_t first_live_level() const override { return first_held; }
-  std::uint32_t level_end() const override { return static_cast<std::uint32_t>(levels.size()); }
+  std::uint32_t level_end() const override {
+    return static_cast<std::uint32_t>(arrived < levels.size() ? arrived : levels.size());
+  }
   bool placement(std::uint32_t level, Pose2* frame, double box[4], std::uint32_t* count) const override {
     std::uint32_t index = 0U;
     if (!node_index(level, &index)) return false;
@@ -119,9 +123,24 @@ struct Rig {
     if (LoopClosure::required_bytes(options, nodes, g) > arena.available_bytes()) return false;
     return loops.init(options, nodes, g, &icp, &owner, &stats, arena);
   }
-  // Runs the search until every level has been searched (bounded).
+  // Search steps (one per processed scan).
+  bool ran = false;
+  void run(int steps) {
+    ran = true;
+    for (int k = 0; k < steps; ++k) loops.search_step();
+  }
+  // Runs the search until it has nothing left to do (bounded). On its first run the
+  // levels arrive one at a time, as segmentation adds them, and each is searched before
+  // the next arrives.
   void search_all() {
-    for (int k = 0; k < 2000; ++k) loops.search_step();
+    if (!ran) {
+      for (std::size_t shown = 1U; shown < owner.levels.size(); ++shown) {
+        owner.arrived = shown;
+        run(2000);
+      }
+    }
+    owner.arrived = SIZE_MAX;
+    run(2000);
   }
 };
 
@@ -334,6 +353,49 @@ TEST(LoopClosure, overlapping_submaps_beyond_the_candidate_cap_are_counted) {
   CHECK_EQUAL(3U, rig->stats.loop_searches);
   CHECK_EQUAL(0U, rig->stats.loop_search_candidates_dropped);
   CHECK_EQUAL(3U, rig->stats.loop_search_closed);
+  CHECK_EQUAL(0U, rig->stats.loop_search_levels_skipped);
+}
+
+namespace {
+bool has_record(const LoopClosure& loops, std::uint32_t older, std::uint32_t newer) {
+  for (std::uint32_t k = 0; k < loops.record_count(); ++k) {
+    if (loops.record(k).older_level == older && loops.record(k).newer_level == newer) return true;
+  }
+  return false;
+}
+}  // namespace
+
+// Newest level first. Six levels see the same room. Level 3's search has started (its
+// first candidate, level 0) when level 4 arrives: level 3's second candidate (level 1) is
+// dropped, and level 4 is searched against all of its own. Then levels 5 and 6 arrive
+// together, before the search had a turn: level 5 is passed over (counted) and level 6
+// is searched.
+TEST(LoopClosure, the_search_takes_the_newest_level_first) {
+  Owner& o = rig->owner;
+  for (int k = 0; k < 7; ++k) o.levels.push_back({Pose2{}, room()});
+  CHECK_TRUE(rig->init());
+  for (std::size_t shown = 1U; shown <= 3U; ++shown) {
+    o.arrived = shown;
+    rig->run(2000);
+  }
+  o.arrived = 4U;
+  rig->run(1);  // level 3's first search starts
+  CHECK_EQUAL(2U, rig->stats.loop_searches);  // level 2 against level 0, level 3 against level 0
+  o.arrived = 5U;
+  rig->run(2000);
+  CHECK_EQUAL(1U, rig->stats.loop_search_candidates_dropped);
+  CHECK_TRUE(has_record(rig->loops, 0U, 3U));
+  CHECK_FALSE(has_record(rig->loops, 1U, 3U));
+  for (std::uint32_t older = 0U; older <= 2U; ++older) CHECK_TRUE(has_record(rig->loops, older, 4U));
+  CHECK_EQUAL(0U, rig->stats.loop_search_levels_skipped);
+  o.arrived = 7U;
+  rig->run(2000);
+  CHECK_EQUAL(1U, rig->stats.loop_search_levels_skipped);
+  for (std::uint32_t older = 0U; older <= 4U; ++older) {
+    CHECK_FALSE(has_record(rig->loops, older, 5U));
+    CHECK_TRUE(has_record(rig->loops, older, 6U));
+  }
+  CHECK_EQUAL(1U, rig->stats.loop_search_candidates_dropped);
 }
 
 // The top level's skeleton match, refined on obstacle points: one record per pair of
@@ -418,7 +480,7 @@ TEST(LoopClosure, a_verified_loop_is_not_displaced_by_a_rival_icp_match) {
   rig = new Rig();
   rig->options.loop_search_reads_per_scan = 10000U;
   build();
-  for (int k = 0; k < 10 && rig->stats.loop_searches == 0U; ++k) rig->loops.search_step();  // the pair's search starts
+  for (int k = 0; k < 10 && rig->stats.loop_searches == 0U; ++k) rig->run(1);  // the pair's search starts
   CHECK_EQUAL(1U, rig->stats.loop_searches);
   CHECK_EQUAL(0U, rig->stats.loop_search_closed);
   rig->loops.refine(0U, a.data(), n, 2U, slid.data(), n, rival2, rival2);

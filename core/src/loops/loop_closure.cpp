@@ -212,18 +212,37 @@ bool LoopClosure::finish_adjustment() {
 // ---- wide loop search (correlative_matcher.h) -------------------------------------------
 
 // A search in progress continues; else the next candidate of the level being searched
-// starts, else the next level's candidates are collected (levels in order, each once,
-// as soon as its obstacle points exist).
+// starts, else the newest level's candidates are collected (each level once, as soon as
+// it is the newest).
+// Newest first: the robot is in the newest level's submap, and a loop found for it
+// corrects the frames it is mapping in now. So once a newer level exists, what is left
+// of the current level's candidates is dropped, and levels that were passed over while
+// one pair was being searched are not searched at all (both counted). A search that went
+// on level by level instead would fall behind the robot for good wherever a level has
+// more candidates than a segment's scans can search.
 void LoopClosure::search_step() {
   if (!(options_.loop_search_window_m > 0.0) || hops_ == nullptr) return;
   if (matcher_.active()) {
     search_continue();
     return;
   }
+  const std::uint32_t end = submaps_->level_end();
+  if (search_cursor_ < search_count_ && search_level_ < end) {
+    stats_->loop_search_candidates_dropped += search_count_ - search_cursor_;
+    search_cursor_ = search_count_;
+  }
   if (search_cursor_ >= search_count_) {
     const std::uint32_t first = submaps_->first_live_level();
     if (search_level_ < first) search_level_ = first;
-    if (search_level_ >= submaps_->level_end()) return;
+    if (search_level_ >= end) return;
+    if (search_level_ + 1U < end) {
+      // Passed over: [search_level_, end - 1). Only a level two past the oldest held one
+      // can have a candidate (adjacent levels never are).
+      const std::uint32_t can = submaps_->first_held_level() + 2U;
+      const std::uint32_t from = search_level_ > can ? search_level_ : can;
+      if (from < end - 1U) stats_->loop_search_levels_skipped += end - 1U - from;
+      search_level_ = end - 1U;
+    }
     search_newer_ = search_level_++;
     search_collect(search_newer_);
     if (search_count_ == 0U) return;

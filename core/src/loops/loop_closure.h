@@ -25,7 +25,8 @@
 // one (a kernel would keep a true loop of metres only partly closed).
 //
 // Wide loop search (loop_search_window_m > 0): ICP only sees loops the chain already
-// closed to within decimetres, so once per level the chosen submap is also searched
+// closed to within decimetres, so once per level, newest level first (search_step()),
+// the chosen submap is also searched
 // against up to loop_search_candidates older, non-adjacent submaps whose boxes (grown by
 // the pair's window) overlap its own (the largest overlaps; the others are counted),
 // exhaustively over ±loop_search_window_m and ±loop_search_window_rad

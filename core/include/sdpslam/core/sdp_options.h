@@ -199,11 +199,14 @@ struct SdpOptions {
   // Older submaps searched per level, largest overlaps first. A place revisited after a
   // long loop overlaps many older submaps (a corridor walked several times, rooms along
   // it), and the one that the drifted chain puts nearest is often not the one the robot
-  // is really in; each candidate is a compute budget (one exact search, spread over
-  // scans by loop_search_reads_per_scan), and each is one more chance for a false peak,
-  // which the verification above has to catch. Overlapping submaps beyond this many are
-  // not searched for that level; they are counted (loop_search_candidates_dropped).
-  std::uint32_t loop_search_candidates = 8U;   // 1 .. kMaxLoopSearchCandidates
+  // is really in, so by default every overlapping submap is a candidate, up to the fixed
+  // capacity. Each is one exact search, spread over scans by
+  // loop_search_reads_per_scan, and one more chance for a false peak, which the
+  // verification above has to catch. The search takes the newest level first
+  // (loop_closure.h), so a long list costs the search no lag behind the robot: the
+  // candidates a newer level preempts are dropped, and so are those beyond this many
+  // (both counted: loop_search_candidates_dropped).
+  std::uint32_t loop_search_candidates = 32U;  // 1 .. kMaxLoopSearchCandidates
   // Grid reads of the search per process() call (about 1 ns each): a search is spread
   // over as many calls as it needs, whole headings at a time (at least one per call).
   std::uint32_t loop_search_reads_per_scan = 3000000U;  // [10000, 1e9]

@@ -32,7 +32,8 @@ struct LoopClosureStats {
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t frame_steps_refused = 0U;   // pose-graph solves ended by a step that raised the objective
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
-  std::uint64_t loop_search_candidates_dropped = 0U;  // older submaps within a level's reach left unsearched: beyond loop_search_candidates
+  std::uint64_t loop_search_candidates_dropped = 0U;  // older submaps within a level's reach left unsearched: beyond loop_search_candidates, or a newer level came first
+  std::uint64_t loop_search_levels_skipped = 0U;      // levels never searched: a newer one was ready before their turn
   std::uint64_t loop_search_weak = 0U;      // ... whose best peak scored below loop_search_min_score
   std::uint64_t loop_search_ambiguous = 0U; // ... with a distinct peak nearly as good
   std::uint64_t loop_search_failed = 0U;    // ... that could not run (too few points, grid too large)

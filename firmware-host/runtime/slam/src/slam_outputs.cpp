@@ -316,7 +316,8 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                           {"far", st.loop_search_far},
                           {"recentred", st.loop_search_recentred},
                           {"recentred_closed", st.loop_search_recentred_closed},
-                          {"candidates_dropped", st.loop_search_candidates_dropped}}}};
+                          {"candidates_dropped", st.loop_search_candidates_dropped},
+                          {"levels_skipped", st.loop_search_levels_skipped}}}};
   io::Json pools = filter_pools_json(bottom);
   pools["pgs_levels"] = {{"capacity", so.max_levels}, {"peak", sp.pgs_levels_peak}, {"refused", st.pgs_refused}};
   pools["permanent_submaps"] = {{"capacity", so.max_permanent_submaps},
