@@ -26,12 +26,11 @@
 //
 // Wide loop search (loop_search_window_m > 0): ICP only sees loops the chain already
 // closed to within decimetres, so once per level, newest level first (search_step()),
-// the chosen submap is also searched
-// against up to loop_search_candidates older, non-adjacent submaps whose boxes (grown by
-// the pair's window) overlap its own (the largest overlaps; the others are counted),
-// exhaustively over ±loop_search_window_m and ±loop_search_window_rad
-// (correlative_matcher.h; the window grows to the chain's drift bound between the two
-// levels, up to loop_search_max_window_m), in slices of
+// the chosen submap is also searched against up to loop_search_candidates older,
+// non-adjacent submaps whose boxes (grown by the pair's window) overlap its own (the
+// largest overlaps; the others are counted), exhaustively over ±loop_search_window_m and
+// ±loop_search_window_rad (correlative_matcher.h; the window grows to the chain's drift
+// bound between the two levels, up to loop_search_max_window_m), in slices of
 // loop_search_reads_per_scan grid reads per search_step(). An unambiguous peak scoring
 // loop_search_min_score that obstacle ICP confirms becomes a constraint unless it would
 // move the newer submap farther than the chain can have drifted
