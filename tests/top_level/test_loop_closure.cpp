@@ -129,16 +129,18 @@ struct Rig {
     ran = true;
     for (int k = 0; k < steps; ++k) loops.search_step();
   }
-  // Runs the search until it has nothing left to do (bounded). On its first run the
-  // levels arrive one at a time, as segmentation adds them, and each is searched before
-  // the next arrives.
-  void search_all() {
-    if (!ran) {
-      for (std::size_t shown = 1U; shown < owner.levels.size(); ++shown) {
-        owner.arrived = shown;
-        run(2000);
-      }
+  // Levels 0 .. count-1 arrive one at a time, as segmentation adds them, and the search
+  // runs after each until it has nothing left to do (bounded).
+  void arrive_one_at_a_time(std::size_t count) {
+    for (std::size_t shown = 1U; shown <= count; ++shown) {
+      owner.arrived = shown;
+      run(2000);
     }
+  }
+  // Runs the search until it has nothing left to do; on its first run the levels arrive
+  // one at a time.
+  void search_all() {
+    if (!ran) arrive_one_at_a_time(owner.levels.size() - 1U);
     owner.arrived = SIZE_MAX;
     run(2000);
   }
@@ -365,7 +367,7 @@ bool has_record(const LoopClosure& loops, std::uint32_t older, std::uint32_t new
 }
 }  // namespace
 
-// Newest level first. Six levels see the same room. Level 3's search has started (its
+// Newest level first. Seven levels see the same room. Level 3's search has started (its
 // first candidate, level 0) when level 4 arrives: level 3's second candidate (level 1) is
 // dropped, and level 4 is searched against all of its own. Then levels 5 and 6 arrive
 // together, before the search had a turn: level 5 is passed over (counted) and level 6
@@ -374,10 +376,7 @@ TEST(LoopClosure, the_search_takes_the_newest_level_first) {
   Owner& o = rig->owner;
   for (int k = 0; k < 7; ++k) o.levels.push_back({Pose2{}, room()});
   CHECK_TRUE(rig->init());
-  for (std::size_t shown = 1U; shown <= 3U; ++shown) {
-    o.arrived = shown;
-    rig->run(2000);
-  }
+  rig->arrive_one_at_a_time(3U);
   o.arrived = 4U;
   rig->run(1);  // level 3's first search starts
   CHECK_EQUAL(2U, rig->stats.loop_searches);  // level 2 against level 0, level 3 against level 0
