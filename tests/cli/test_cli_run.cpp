@@ -302,6 +302,36 @@ TEST(CliRun, filter_particles_is_honoured_in_sdp_mode) {
   STRCMP_CONTAINS("\"bottom_particles\": 10,", slurp_without_timing(dir + "/c/stats.json").c_str());
 }
 
+// How the bottom level drew its particles is counted in sdp mode as in dpslam mode: with
+// the improved proposal (the accurate profile) every particle of every step is drawn
+// around a match or by the odometry fallback, and counted once as one or the other; with
+// the paper's odometry proposal nothing is.
+TEST(CliRun, the_bottom_levels_proposals_are_counted_in_sdp_mode) {
+  std::string text;
+  for (int i = 0; i < 40; ++i) text += scan(0.05 * i, 100.0 + 0.1 * i);
+  const std::string log = put("walk.clf", text);
+  auto proposals = [&](const std::string& args, nlohmann::json* stats) {
+    Run r = run_cli("run " + log + " " + args + " --quiet --out " + dir + "/out");
+    LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+    const std::string stats_text = text_of(dir + "/out/stats.json");
+    *stats = nlohmann::json::parse(stats_text, nullptr, false);
+    CHECK_FALSE_TEXT(stats->is_discarded(), stats_text.c_str());
+    const nlohmann::json& p = (*stats)["proposal"];
+    return p["matched"].get<std::uint64_t>() + p["fallback_few_beams"].get<std::uint64_t>() +
+           p["fallback_empty_map"].get<std::uint64_t>() + p["fallback_low_score"].get<std::uint64_t>();
+  };
+  nlohmann::json stats;
+  const std::uint64_t drawn = proposals("", &stats);
+  const auto particles = stats["bottom_particles"].get<std::uint64_t>();
+  const auto processed = stats["processed_scans"].get<std::uint64_t>();
+  CHECK_TRUE(processed >= 5U);
+  // Every processed scan after the first draws each particle once.
+  LONGS_EQUAL(particles * (processed - 1U), drawn);
+  CHECK_TRUE(stats["proposal"]["evaluations"].get<std::uint64_t>() >= stats["proposal"]["matched"].get<std::uint64_t>());
+  LONGS_EQUAL(0, proposals("--profile paper", &stats));
+  LONGS_EQUAL(0, stats["proposal"]["evaluations"].get<std::uint64_t>());
+}
+
 // --print-config shows what the profile, the file and the flags made of the options,
 // nothing hidden: flags and profile appear in it, and it reads back as the same run's
 // configuration.

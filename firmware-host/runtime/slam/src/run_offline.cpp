@@ -117,11 +117,7 @@ RunStatus run_offline(const std::string& log_path, const RunOptions& options, co
   js["odometry_jumps_removed"] = reader.odometry_jumps_removed();
   js["scans_stamped_backwards"] = reader.scans_stamped_backwards();
   js["resamplings"] = st.resamplings;
-  js["proposal"] = {{"matched", st.proposal_matched},
-                    {"fallback_few_beams", st.proposal_fallback_few_beams},
-                    {"fallback_empty_map", st.proposal_fallback_empty_map},
-                    {"fallback_low_score", st.proposal_fallback_low_score},
-                    {"evaluations", st.proposal_evaluations}};
+  js["proposal"] = proposal_json(st);
   io::Json pools = filter_pools_json(*filter);
   pools["map_updates_dropped"] = st.map_updates_dropped;
   pools["out_of_map_updates"] = map.out_of_bounds_count();

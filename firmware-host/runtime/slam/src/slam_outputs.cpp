@@ -211,6 +211,14 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
   return known_cells;
 }
 
+io::Json proposal_json(const DpSlamStats& stats) {
+  return {{"matched", stats.proposal_matched},
+          {"fallback_few_beams", stats.proposal_fallback_few_beams},
+          {"fallback_empty_map", stats.proposal_fallback_empty_map},
+          {"fallback_low_score", stats.proposal_fallback_low_score},
+          {"evaluations", stats.proposal_evaluations}};
+}
+
 io::Json filter_pools_json(const DpSlamFilter& filter) {
   const AncestryTree& tree = filter.tree();
   const DpMap& map = filter.map();
@@ -291,6 +299,7 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                      {"icp_failures", st.icp_failures}};
   js["top_work_deferred"] = st.top_work_deferred;
   js["bottom_proposal"] = bottom.options().proposal == DpSlamOptions::Proposal::kScanMatch ? "scan_match" : "odometry";
+  js["proposal"] = proposal_json(bs);
   js["loop_closure"] = {{"enabled", so.loop_closure},
                         {"records", st.loop_records},
                         {"refinements", st.loop_refinements},

@@ -154,6 +154,13 @@ std::uint32_t sdp_global_map_image(const SdpSlam& slam, io::OccupancyImage* imag
 // its own after them. Shared by the DP-SLAM and SDP-SLAM stats.
 io::Json filter_pools_json(const DpSlamFilter& filter);
 
+// How the bottom filter's particles were drawn with the improved proposal (a stats.json
+// "proposal" object): around a scan match, or by the odometry model when the match could
+// not be made (too few return beams, a map too empty, a score too low), and the matcher's
+// observation-model calls. All zero with the odometry proposal. Shared by the DP-SLAM and
+// SDP-SLAM stats.
+io::Json proposal_json(const DpSlamStats& stats);
+
 // The deterministic part of an SDP-SLAM stats.json: the members "segments" through
 // "memory", in order, for the caller to append to its object (sdpslamd's status.json
 // "engine" takes the same). `arena_bytes` / `arena_used_bytes`: the arena given to init()
