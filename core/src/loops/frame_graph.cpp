@@ -322,7 +322,9 @@ void FrameGraph::optimise() {
   double current = stats_.last_chi2_before;
   constexpr std::uint32_t kHalvings = 8U;
   constexpr double kRounding = 1e-9;  // relative; double rounding over the sums is ~1e-15
+  bool capped = false;  // the last step was accepted and still making headway (kConverged)
   for (std::uint32_t it = 0; it < options_.iterations; ++it) {
+    capped = false;
     for (std::uint32_t k = 1; k < n_; ++k) linearise(seq_[k], lin_[k]);
     for (std::uint32_t q = 0; q < loops_; ++q) {
       Linear& l = lin_[options_.max_nodes + q];
@@ -389,6 +391,7 @@ void FrameGraph::optimise() {
     double scale = 1.0;
     double step = 0.0;
     bool accepted = false;
+    bool converged = false;
     for (std::uint32_t h = 0; h <= kHalvings; ++h, scale *= 0.5) {
       step = 0.0;
       for (std::uint32_t k = 1; k < n_; ++k) {
@@ -400,6 +403,7 @@ void FrameGraph::optimise() {
       }
       const double after = total_chi2();
       if (after <= current * (1.0 + kRounding)) {
+        converged = current - after <= kConverged * current;
         current = after;
         accepted = true;
         break;
@@ -414,8 +418,10 @@ void FrameGraph::optimise() {
       ++stats_.refused_steps;
       break;
     }
+    capped = !converged && !(step < 1e-14);
     if (step < 1e-14) break;
   }
+  if (capped) ++stats_.capped;
   std::uint32_t down = 0U;
   for (std::uint32_t q = 0; q < loops_; ++q) {
     loop_w_[q] = kernel_weight(chi2(loop_[q]), loop_[q].c2);

@@ -23,6 +23,11 @@
 // Solver: Gauss-Newton on the poses (additive update of x, y, θ), with step acceptance:
 // a step that raises the objective is halved until it does not, or refused (the poses
 // stay and the solve ends), so a solve never leaves the graph worse than it found it.
+// A solve takes `iterations` steps at most; one whose last step still lowered the
+// objective by more than kConverged of it ended before convergence, and is counted
+// (FrameGraphStats::capped): a loop that closes metres of drift around a long chain
+// needs tens of steps (its heading error makes the problem far from linear), and the
+// correction of a solve cut short lies where its first steps put it.
 // Each step solves H Δ = -b by preconditioned conjugate gradients; H is never formed,
 // H·v is summed over the constraints. The preconditioner is H without the loop
 // constraints' off-diagonal blocks: block-tridiagonal (the chain), factorised exactly
@@ -88,10 +93,14 @@ struct FrameGraphStats {
   double last_chi2_after = 0.0;
   std::uint32_t last_downweighted = 0U;  // loops with kernel weight < 0.5 at the end
   std::uint64_t refused_steps = 0U;      // Gauss-Newton steps that raised the objective even when halved
+  std::uint64_t capped = 0U;             // solves whose last step still lowered the objective by > kConverged of it
 };
 
 class FrameGraph {
  public:
+  // Convergence: a step that lowers the objective by less than this share of it (well
+  // above the rounding of its sums, ~1e-15 relative).
+  static constexpr double kConverged = 1e-6;
   static std::size_t required_bytes(const FrameGraphOptions& o);
   // False iff the options are invalid or the arena is too small.
   bool init(const FrameGraphOptions& o, Arena& arena);

@@ -202,9 +202,11 @@ bool LoopClosure::finish_adjustment() {
   stats_->loop_constraints_used = used;
   if (used == 0U) return false;  // the chain alone is already consistent
   const std::uint64_t refused_before = g.stats().refused_steps;
+  const std::uint64_t capped_before = g.stats().capped;
   g.optimise();
   ++stats_->frame_adjustments;
   stats_->frame_steps_refused += g.stats().refused_steps - refused_before;
+  stats_->frame_adjustments_capped += g.stats().capped - capped_before;
   stats_->loop_downweighted = g.stats().last_downweighted;
   return true;
 }

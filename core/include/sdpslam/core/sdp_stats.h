@@ -31,6 +31,7 @@ struct LoopClosureStats {
   std::uint64_t frame_adjustments = 0U;     // pose-graph solves
   std::uint64_t frame_graph_refused = 0U;   // nodes or loops that did not fit the graph
   std::uint64_t frame_steps_refused = 0U;   // pose-graph solves ended by a step that raised the objective
+  std::uint64_t frame_adjustments_capped = 0U;  // pose-graph solves that ended after graph_iterations steps still converging
   std::uint64_t loop_searches = 0U;         // wide searches run (pairs of submaps)
   std::uint64_t loop_search_candidates_dropped = 0U;  // older submaps within a level's reach left unsearched: beyond loop_search_candidates, or a newer level came first
   std::uint64_t loop_search_levels_skipped = 0U;      // levels never searched: a newer one was ready before their turn

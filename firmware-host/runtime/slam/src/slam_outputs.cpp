@@ -313,6 +313,7 @@ io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_
                         {"adjustments", st.frame_adjustments},
                         {"graph_refused", st.frame_graph_refused},
                         {"steps_refused", st.frame_steps_refused},
+                        {"adjustments_capped", st.frame_adjustments_capped},
                         {"search",
                          {{"window_m", fixed(so.loop_search_window_m, 3)},
                           {"max_window_m", fixed(so.loop_search_max_window_m, 3)},
