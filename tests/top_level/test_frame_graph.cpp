@@ -53,6 +53,27 @@ struct Rig {
       CHECK_TRUE(g.add_node(k == 0 ? truth[0] : est, z, FrameInfo::from_sigma(0.1, 0.02)));
     }
   }
+  // `frames` frames round and round the square, every step turned `bias_rad` too far,
+  // and a loop constraint (the truth) one lap back from every `loop_stride`-th frame
+  // after the first lap, behind the kernel.
+  void build_wound_laps(FrameGraph& g, std::uint32_t frames, double bias_rad, std::uint32_t loop_stride) {
+    g.clear();
+    const std::uint32_t lap = static_cast<std::uint32_t>(truth.size());
+    Pose2 est = truth[0];
+    for (std::uint32_t k = 0; k < frames; ++k) {
+      Pose2 z;
+      if (k > 0U) {
+        z = between(truth[(k - 1U) % lap], truth[k % lap]);
+        z.heading_rad += bias_rad;
+        est = est.compose(z);
+      }
+      CHECK_TRUE(g.add_node(est, z, FrameInfo::from_sigma(0.05, 0.01)));
+    }
+    for (std::uint32_t k = lap; k < frames; k += loop_stride) {
+      const Pose2 z = between(truth[(k - lap) % lap], truth[k % lap]);
+      CHECK_TRUE(g.add_loop(k - lap, k, z, FrameInfo::from_sigma(0.1, 0.02)));
+    }
+  }
 };
 
 }  // namespace
@@ -304,23 +325,8 @@ TEST(FrameGraph, a_solve_never_raises_the_objective_however_far_the_chain_has_wo
   o.max_loops = 384U;
   FrameGraph g;
   CHECK_TRUE(g.init(o, rig->arena));
-  const std::vector<Pose2>& t = rig->truth;
-  const std::uint32_t lap = static_cast<std::uint32_t>(t.size());
   for (const double bias_rad : {0.01, 0.02}) {
-    g.clear();
-    Pose2 est = t[0];
-    for (std::uint32_t k = 0; k < o.max_nodes; ++k) {
-      Pose2 z;
-      if (k > 0U) {
-        z = between(t[(k - 1U) % lap], t[k % lap]);
-        z.heading_rad += bias_rad;
-        est = est.compose(z);
-      }
-      CHECK_TRUE(g.add_node(est, z, FrameInfo::from_sigma(0.05, 0.01)));
-    }
-    for (std::uint32_t k = lap; k < o.max_nodes; ++k) {
-      CHECK_TRUE(g.add_loop(k - lap, k, between(t[(k - lap) % lap], t[k % lap]), FrameInfo::from_sigma(0.1, 0.02)));
-    }
+    rig->build_wound_laps(g, o.max_nodes, bias_rad, 1U);
     g.optimise();
     CHECK_TRUE(std::isfinite(g.stats().last_chi2_after));
     CHECK_TRUE(g.stats().last_chi2_after < g.stats().last_chi2_before);  // and it still makes headway
@@ -362,35 +368,17 @@ TEST(FrameGraph, a_converged_solve_refuses_no_step_for_rounding) {
 // Five Gauss-Newton steps leave the objective well above its optimum, and the solve
 // says so (capped); fifty reach it and do not; a solve that starts there does not.
 TEST(FrameGraph, a_solve_cut_short_of_convergence_is_counted) {
-  const std::vector<Pose2>& t = rig->truth;
-  const auto build = [&t](FrameGraph& g) {
-    g.clear();
-    const std::uint32_t lap = static_cast<std::uint32_t>(t.size());
-    Pose2 est = t[0];
-    for (std::uint32_t k = 0; k < 400U; ++k) {
-      Pose2 z;
-      if (k > 0U) {
-        z = between(t[(k - 1U) % lap], t[k % lap]);
-        z.heading_rad += 0.005;
-        est = est.compose(z);
-      }
-      CHECK_TRUE(g.add_node(est, z, FrameInfo::from_sigma(0.05, 0.01)));
-    }
-    for (std::uint32_t k = lap; k < 400U; k += 7U) {
-      CHECK_TRUE(g.add_loop(k - lap, k, between(t[(k - lap) % lap], t[k % lap]), FrameInfo::from_sigma(0.1, 0.02)));
-    }
-  };
-  FrameGraphOptions o;
-  o.max_nodes = 400U;
-  o.max_loops = 64U;
-  o.iterations = 50U;
   FrameGraph full;
-  CHECK_TRUE(full.init(o, rig->arena));
-  o.iterations = 5U;
   FrameGraph cut;
-  CHECK_TRUE(cut.init(o, rig->arena));
-  build(full);
-  build(cut);
+  for (FrameGraph* g : {&full, &cut}) {
+    FrameGraphOptions o;
+    o.max_nodes = 400U;
+    o.max_loops = 64U;
+    o.iterations = g == &full ? 50U : 5U;
+    CHECK_TRUE(g->init(o, rig->arena));
+  }
+  rig->build_wound_laps(full, 400U, 0.005, 7U);
+  rig->build_wound_laps(cut, 400U, 0.005, 7U);
   full.optimise();
   cut.optimise();
   const double optimum = full.stats().last_chi2_after;
