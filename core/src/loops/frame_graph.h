@@ -25,9 +25,9 @@
 // stay and the solve ends), so a solve never leaves the graph worse than it found it.
 // A solve takes `iterations` steps at most; one whose last step still lowered the
 // objective by more than kConverged of it ended before convergence, and is counted
-// (FrameGraphStats::capped): a loop that closes metres of drift around a long chain
-// needs tens of steps (its heading error makes the problem far from linear), and the
-// correction of a solve cut short lies where its first steps put it.
+// (FrameGraphStats::capped). A graph far from its optimum with many loops behind the
+// kernel can need tens of steps (every step re-weights the loops), and the correction
+// of a solve cut short lies where its first steps put it.
 // Each step solves H Δ = -b by preconditioned conjugate gradients; H is never formed,
 // H·v is summed over the constraints. The preconditioner is H without the loop
 // constraints' off-diagonal blocks: block-tridiagonal (the chain), factorised exactly
