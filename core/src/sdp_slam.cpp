@@ -134,7 +134,8 @@ std::size_t SdpSlamImpl::required_arena_bytes(const DpSlamOptions& bottom_in, co
   total += SubmapStore::required_bytes(store_options(s, b.particle_count));
   total += TopParticles::required_bytes(TopParticleOptions::from(s));
   total += Arena::bytes_for<std::uint32_t>(L) + 2U * Arena::bytes_for<Pose2>(L) + Arena::bytes_for<Pose2>(n);
-  total += PoseRing::required_bytes(ring_capacity_for(s)) + CombinationEvaluator::required_bytes() + Arena::bytes_for<NodeId>(n);
+  total += PoseRing::required_bytes(ring_capacity_for(s)) + CombinationEvaluator::required_bytes() + Arena::bytes_for<NodeId>(n * L) +
+           Arena::bytes_for<PendingCopy>(L);
   if (s.loop_closure) {
     total += LoopClosure::required_bytes(s, graph_nodes(s), search_geometry(b, s));
     total += 2U * Arena::bytes_for<Point2>(s.loop_points);
@@ -265,14 +266,16 @@ bool SdpSlamImpl::init(const DpSlamOptions& bottom_in, const SdpOptions& s, Aren
       return false;
     }
   }
-  release_queue_ = arena.allocate_array<NodeId>(n_bottom_);
+  release_capacity_ = n_bottom_ * s.max_levels;
+  release_queue_ = arena.allocate_array<NodeId>(release_capacity_);
+  copy_queue_ = arena.allocate_array<PendingCopy>(s.max_levels);
   const std::uint32_t fs = fine_side_cells(b, s);
   fine_cells_ = static_cast<std::size_t>(fs) * fs;
   fine_values_ = arena.allocate_array<CellObservation>(fine_cells_);
   fine_known_ = arena.allocate_array<std::uint8_t>(fine_cells_);
   if (chain_ == nullptr || frames_ == nullptr ||
       eval_frames_ == nullptr || poses_scratch_ == nullptr || fine_values_ == nullptr ||
-      fine_known_ == nullptr || release_queue_ == nullptr) {
+      fine_known_ == nullptr || release_queue_ == nullptr || copy_queue_ == nullptr) {
     std::snprintf(why_, sizeof why_, "arena exhausted while carving SDP-SLAM state");
     return false;
   }
@@ -550,13 +553,13 @@ std::uint64_t SdpSlamImpl::observations_needed() const {
 }
 
 // The levels that go are decided on the room as it will be once their releases and map
-// copies are done; the releases and copy of the last of them are deferred: they give
-// their observations back over the next scans, one submap (or one slice of the copy)
-// per scan, outside do_work()'s budget, so that the scan of a segmentation does not pay
-// for a whole level. Until then that room counts as made wherever the pool's room is
-// judged (here, the segment's pool check in process()), and a scan whose writes need it
-// now takes it at once (make_room_now()). Which levels go, and when, is the same as if
-// every release were done at once.
+// copies are done; the releases and copies of all of them are deferred: they give their
+// observations back over the next scans, one submap (or one slice of a copy) per scan,
+// outside do_work()'s budget, so that the scan of a segmentation does not pay for a
+// whole level, even when it makes two or more levels permanent. Until then that room
+// counts as made wherever the pool's room is judged (here, the segment's pool check in
+// process()), and a scan whose writes need it now takes it at once (make_room_now()).
+// Which levels go, and when, is the same as if every release were done at once.
 void SdpSlamImpl::make_room(std::uint64_t need) {
   const DpMap& map = filter_->map();
   const std::uint64_t capacity = map.observation_capacity();
@@ -567,7 +570,7 @@ void SdpSlamImpl::make_room(std::uint64_t need) {
   };
   while (short_of_room() && graph_.live_level_count() > 0U) {
     const std::uint64_t before = stats_.levels_made_permanent;
-    make_oldest_permanent();  // completes the previous level's releases and copy first
+    make_oldest_permanent();  // queues its releases and copy behind those pending
     if (stats_.levels_made_permanent == before) return;
     defer_pending_releases();
     ++stats_.levels_made_permanent_for_room;
@@ -580,8 +583,8 @@ void SdpSlamImpl::make_room_now(std::uint64_t need) {
   const DpMap& map = filter_->map();
   auto fits = [&] { return std::uint64_t{map.observations_used()} + need <= std::uint64_t{map.observation_capacity()}; };
   while (releases_deferred_ && !fits() && release_count_ > 0U) release_one();
-  while (releases_deferred_ && !fits() && transfer_.active()) transfer_step(0xFFFFFFFFU);
-  if (releases_deferred_ && release_count_ == 0U && !transfer_.active()) releases_deferred_ = false;
+  while (releases_deferred_ && !fits() && copies_pending()) transfer_step(0xFFFFFFFFU);
+  if (releases_deferred_ && release_count_ == 0U && !copies_pending()) releases_deferred_ = false;
   if (fits()) return;
   make_room(need);
   finish_releases();
@@ -589,19 +592,35 @@ void SdpSlamImpl::make_room_now(std::uint64_t need) {
 
 // A permanent level's tree goes whole: its other submaps are released (prune frees
 // their lineages and folds the rest into the chosen one), and the chosen submap is
-// copied into the global map and released. One level's work is pending at a time (the
-// next one completes it first), so its tree is the queue's and the copy's.
+// copied into the global map and released. Several levels' work may be pending (queued
+// releases, the copy in progress, queued copies): the observations of all their trees.
 std::uint64_t SdpSlamImpl::pending_release_observations() const {
-  NodeId node = kNoNode;
-  CellRect rest;
-  if (!transfer_.pending(&node, &rest) && release_count_ > 0U) node = release_queue_[0];
   const AncestryTree& tree = filter_->tree();
-  if (node == kNoNode || !tree.contains(node)) return 0U;
-  const std::uint32_t sequence = tree.tree_sequence_unchecked(node);
   const DpMap& map = filter_->map();
+  // The pending nodes: queued releases, the copy in progress, queued copies.
+  NodeId copying = kNoNode;
+  CellRect rest;
+  if (!transfer_.pending(&copying, &rest)) copying = kNoNode;
+  const std::uint32_t total = release_count_ + 1U + copy_count_;
+  const auto pending_node = [&](std::uint32_t k) {
+    if (k < release_count_) return release_queue_[k];
+    if (k == release_count_) return copying;
+    return copy_queue_[k - release_count_ - 1U].node;
+  };
   std::uint64_t held = 0U;
-  for (NodeId n = 0U; n < tree.capacity(); ++n) {
-    if (tree.contains(n) && tree.tree_sequence_unchecked(n) == sequence) held += map.observation_count(n);
+  for (std::uint32_t k = 0; k < total; ++k) {
+    const NodeId node = pending_node(k);
+    if (node == kNoNode || !tree.contains(node)) continue;
+    const std::uint32_t sequence = tree.tree_sequence_unchecked(node);
+    bool counted = false;  // an earlier pending node of the same tree (a level's are adjacent)
+    for (std::uint32_t j = k; j > 0U && !counted; --j) {
+      const NodeId other = pending_node(j - 1U);
+      counted = other != kNoNode && tree.contains(other) && tree.tree_sequence_unchecked(other) == sequence;
+    }
+    if (counted) continue;
+    for (NodeId n = 0U; n < tree.capacity(); ++n) {
+      if (tree.contains(n) && tree.tree_sequence_unchecked(n) == sequence) held += map.observation_count(n);
+    }
   }
   return held;
 }
@@ -610,29 +629,33 @@ void SdpSlamImpl::deferred_release_step() {
   if (!releases_deferred_) return;
   if (release_count_ > 0U) {
     release_one();
-  } else if (transfer_.active()) {
+  } else if (copies_pending()) {
     transfer_step(options_.work_cells_per_scan);
   }
-  if (release_count_ == 0U && !transfer_.active()) releases_deferred_ = false;
+  if (release_count_ == 0U && !copies_pending()) releases_deferred_ = false;
 }
 
 std::uint64_t SdpSlamImpl::scan_burst() const {
   return scan_requests_ > previous_scan_requests_ ? scan_requests_ : previous_scan_requests_;
 }
 
-// The pending releases and the permanent submap's copy, all now.
+// The pending releases and the permanent submaps' copies, all now.
 void SdpSlamImpl::finish_releases() {
   while (release_count_ > 0U) release_one();
-  while (transfer_.active()) transfer_step(0xFFFFFFFFU);
+  while (copies_pending()) transfer_step(0xFFFFFFFFU);
 }
 
 void SdpSlamImpl::make_oldest_permanent() {
   const std::uint32_t level = graph_.first_live_level();
   if (!graph_.is_live(level)) return;
-  // Pending work first (the previous level's releases and transfer, this level's skeletons).
-  finish_releases();
-  releases_deferred_ = false;
+  // Pending work first: this level's skeletons. The earlier levels' releases and copies
+  // stay queued (the scan that makes two levels permanent does not pay for the first
+  // one's), unless the queues have no room for this level's: then they are done now.
   const std::uint32_t count = store_.level(level).count;
+  if (release_count_ + count > release_capacity_ || copy_count_ >= options_.max_levels) {
+    finish_releases();
+    releases_deferred_ = false;
+  }
   for (std::uint32_t k = 0; k < count; ++k) {
     if (!store_.submap(level, k).skeleton_done) extract_skeleton(level, k);
   }
@@ -658,9 +681,9 @@ void SdpSlamImpl::make_oldest_permanent() {
   // The other submaps of the level are released now; the chosen one once its map has
   // been copied into the global map node.
   for (std::uint32_t k = 0; k < count; ++k) {
-    if (k != chosen && release_count_ < n_bottom_) release_queue_[release_count_++] = store_.submap(level, k).node;
+    if (k != chosen && release_count_ < release_capacity_) release_queue_[release_count_++] = store_.submap(level, k).node;
   }
-  transfer_.start(sm.node, r.frame_in_global, level + 1U, sm.map_rect);
+  copy_queue_[copy_count_++] = PendingCopy{sm.node, r.frame_in_global, level, sm.map_rect};
   // Committed poses of the level leave the ring (they are the oldest).
   ring_.drop_through(store_.level(level).end_stamp_us);
   store_.level(level).count = 0U;
@@ -668,6 +691,13 @@ void SdpSlamImpl::make_oldest_permanent() {
 
 // The permanent submap's copy into the global map (map_transfer.h), within the budget.
 std::uint32_t SdpSlamImpl::transfer_step(std::uint32_t budget_cells) {
+  if (!transfer_.active()) {
+    if (copy_count_ == 0U) return 0U;
+    const PendingCopy c = copy_queue_[0];
+    for (std::uint32_t k = 1; k < copy_count_; ++k) copy_queue_[k - 1U] = copy_queue_[k];
+    --copy_count_;
+    transfer_.start(c.node, c.frame, c.level + 1U, c.rect);
+  }
   const TransferStep st = transfer_.work(budget_cells, *filter_, permanent_map_, fine_buffer());
   stats_.map_transfer_cells += st.cells_copied;
   stats_.map_transfer_dropped += st.cells_dropped;
@@ -697,7 +727,7 @@ std::uint32_t SdpSlamImpl::do_work(std::uint32_t budget_cells) {
   // pool is what the bottom level's new observations come from.
   // It waits for the releases (one per call): they let prune fold the submap's lineage
   // into its node, which can then be popped.
-  if (own_releases && transfer_.active() && release_count_ == 0U && used < budget_cells) {
+  if (own_releases && copies_pending() && release_count_ == 0U && used < budget_cells) {
     used += transfer_step(budget_cells - used);
   }
   if (used >= budget_cells) return used;

@@ -60,6 +60,8 @@ SdpPools SdpSlam::pools() const {
   p.pgs_levels_peak = impl().graph().peak_levels_used();
   p.permanent_submaps = impl().permanent_submap_count();
   p.pose_ring_capacity = impl().pose_ring_capacity();
+  p.pending_releases = impl().pending_releases();
+  p.pending_copies = impl().pending_copies();
   p.permanent_map_tile_capacity = map.tile_capacity();
   p.permanent_map_tiles_used = map.tiles_used();
   p.permanent_map_known_cells = map.known_cells();

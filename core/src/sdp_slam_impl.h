@@ -77,6 +77,8 @@ class SdpSlamImpl {
   }
   std::uint32_t permanent_submap_count() const { return store_.permanent_count(); }
   std::uint32_t pose_ring_capacity() const { return ring_.capacity(); }
+  std::uint32_t pending_copies() const { return (transfer_.active() ? 1U : 0U) + copy_count_; }
+  std::uint32_t pending_releases() const { return release_count_; }
   std::size_t arena_bytes_used() const { return arena_used_; }
   void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;
 
@@ -116,7 +118,8 @@ class SdpSlamImpl {
   std::uint64_t pending_release_observations() const;
   // Of them, those make_room() deferred: room counted as made.
   std::uint64_t deferred_observations() const { return releases_deferred_ ? pending_release_observations() : 0U; }
-  void defer_pending_releases() { releases_deferred_ = release_count_ > 0U || transfer_.active(); }
+  void defer_pending_releases() { releases_deferred_ = release_count_ > 0U || copies_pending(); }
+  bool copies_pending() const { return transfer_.active() || copy_count_ > 0U; }
   // One slice of the deferred releases and map copy (once per process()).
   void deferred_release_step();
   // The most DP map observations one processed scan asked for, in this segment or the previous one.
@@ -209,11 +212,25 @@ class SdpSlamImpl {
   Point2* obst_b_ = nullptr;
   LoopClosure loop_closure_;
   LoopView loop_view_{*this};
-  // Submaps of a permanent level waiting to be released, one per call of process()
-  // (freeing a submap's observations walks their cell lists: spread over scans).
-  NodeId* release_queue_ = nullptr;  // N
+  // Submaps of permanent levels waiting to be released, one per call of process()
+  // (freeing a submap's observations walks their cell lists: spread over scans). Several
+  // levels' may wait at once: a segmentation that makes two levels permanent leaves the
+  // first one's releases queued instead of doing them in its own scan.
+  NodeId* release_queue_ = nullptr;  // N × max_levels
   std::uint32_t release_count_ = 0U;
-  MapTransfer transfer_;  // the newest permanent submap's copy into permanent_map_
+  std::uint32_t release_capacity_ = 0U;
+  // The copy of a permanent level's submap into permanent_map_, one at a time, oldest
+  // level first; the levels made permanent while one is copied wait in copy_queue_ (each
+  // starts once the releases queued before it are done: pop mode, map_transfer.h).
+  struct PendingCopy {
+    NodeId node = kNoNode;
+    Pose2 frame;
+    std::uint32_t level = 0U;
+    CellRect rect{};
+  };
+  MapTransfer transfer_;
+  PendingCopy* copy_queue_ = nullptr;  // max_levels
+  std::uint32_t copy_count_ = 0U;
   PermanentMap permanent_map_;
 
   // Current segment.
@@ -290,12 +307,17 @@ void SdpSlamImpl::for_each_best_pose(F&& f) const {
 template <class F>
 void SdpSlamImpl::for_each_best_submap(F&& f) const {
   if (!initialised_ || !started_) return;
+  // What the permanent map does not hold yet, at its level's frame now: the rest of the
+  // copy in progress, and the submaps waiting for theirs.
   NodeId copying = kNoNode;
   CellRect rest{};
-  if (transfer_.pending(&copying, &rest) && store_.permanent_count() > 0U) {
-    // What the permanent map does not hold yet, at its level's frame now (the newest
-    // permanent submap).
-    f(copying, store_.permanent(store_.permanent_slot_at(store_.permanent_count() - 1U)).frame_in_global, rest);
+  std::uint32_t slot = 0U;
+  if (transfer_.pending(&copying, &rest) && store_.find_permanent(transfer_.tag() - 1U, &slot)) {
+    f(copying, store_.permanent(slot).frame_in_global, rest);
+  }
+  for (std::uint32_t k = 0; k < copy_count_; ++k) {
+    const PendingCopy& c = copy_queue_[k];
+    if (store_.find_permanent(c.level, &slot)) f(c.node, store_.permanent(slot).frame_in_global, c.rect);
   }
   const std::uint32_t first = graph_.first_live_level();
   const std::uint32_t count = graph_.live_level_count();

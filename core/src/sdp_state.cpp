@@ -150,6 +150,7 @@ void SdpSlamImpl::transfer_state(StateIo& io) {
   io.value(release_count_);
   io.value(releases_deferred_);
   transfer_.transfer_state(io);
+  io.value(copy_count_);
   permanent_map_.transfer_state(io);
   io.section("segment");
   io.value(started_);

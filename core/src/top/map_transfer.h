@@ -54,6 +54,8 @@ class MapTransfer {
   // While a copy is active: the node and the part of its rectangle not copied yet (a
   // popped node keeps only the cells not copied; in rows, the rows not copied).
   bool pending(NodeId* node, CellRect* rest) const;
+  // The tag of the active copy (its level + 1); 0 when none is active.
+  std::uint32_t tag() const { return job_.active ? job_.tag : 0U; }
 
   void transfer_state(StateIo& io) { io.value(job_); }
 

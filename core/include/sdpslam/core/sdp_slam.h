@@ -141,6 +141,11 @@ struct SdpPools {
   std::uint32_t pgs_levels_peak = 0U;  // live PGS levels at most (capacity: max_levels)
   std::uint32_t permanent_submaps = 0U;  // held now (capacity: max_permanent_submaps)
   std::uint32_t pose_ring_capacity = 0U;  // committed poses of the live levels
+  // Work on permanent levels not done yet, spread over the next scans: submaps waiting to
+  // be released (at most max_levels levels' worth), and permanent submaps whose copy into
+  // the permanent map is not complete (for_each_best_submap draws them meanwhile).
+  std::uint32_t pending_releases = 0U;
+  std::uint32_t pending_copies = 0U;
   // The global map's permanent part (permanent_map_tiles; PermanentMap): tiles, cells
   // known, compactions, the side of its cells (DP-map cells × 2^scale_log2) and the
   // writes refused for want of a tile.
@@ -209,8 +214,8 @@ class SdpSlam {
   }
   // f(node, frame_in_global, rect) for every DP-map view that makes up the best global
   // map besides its permanent part: the permanent submap still being copied (what is
-  // not copied yet), each live level's chosen submap and the current segment's best
-  // particle; rect bounds the cells worth reading.
+  // not copied yet) and those waiting for their copy, each live level's chosen submap
+  // and the current segment's best particle; rect bounds the cells worth reading.
   template <class F>
   void for_each_best_submap(F&& f) const {
     visit_best_submaps(&call<F, NodeId, const Pose2&, const CellRect&>, context_of(f));
@@ -303,7 +308,7 @@ class SdpSlam {
 
   // Bytes of the engine's own storage: at least sizeof(SdpSlamImpl) on every target
   // (checked where the engine is built, sdp_slam.cpp).
-  static constexpr std::size_t kStorageBytes = 9216U;
+  static constexpr std::size_t kStorageBytes = 9280U;
 
  private:
   // The visits above, without templates: fn(context, ...) per item. `context` is the
