@@ -508,6 +508,16 @@ TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   const std::string used = json.substr(json.find("\"used\""));
   STRCMP_CONTAINS("\"between\": 0, \"wrong\": 0", used.c_str());
   CHECK_TEXT(used.find("\"count\": 0,") == std::string::npos, used.c_str());
+  // stats.json counts the pose-graph solves those loops made, and those of them that ended
+  // before converging.
+  const std::string stats_text = text_of(dir + "/run/stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(stats_text, nullptr, false);
+  CHECK_FALSE_TEXT(stats.is_discarded(), stats_text.c_str());
+  const nlohmann::json& lc = stats["loop_closure"];
+  CHECK_TRUE(lc["adjustments"].is_number_unsigned());
+  CHECK_TRUE(lc["adjustments_capped"].is_number_unsigned());
+  CHECK(lc["adjustments"].get<std::uint64_t>() > 0U);
+  CHECK(lc["adjustments_capped"].get<std::uint64_t>() <= lc["adjustments"].get<std::uint64_t>());
 }
 
 // `sdpslam localize` on a simulated world's own map, from the ground truth's first pose:
