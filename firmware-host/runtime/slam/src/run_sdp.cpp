@@ -229,7 +229,9 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
     const double cpu = thread_cpu_ms() - c0;
     scan_cpu_ms.push_back(cpu);
     // Where the worst scans come from: segmentation, top-level evaluation, anchorage
-    // work alone, or the bottom filter alone.
+    // work alone, or the bottom filter alone. Each is the scan's whole time, the bottom
+    // filter's included when it processed the scan: a slow "evaluation" scan may be slow
+    // for its bottom-level work (scan_cpu_ms_max_bottom_processed says how slow that got).
     const int kind = r.segmented != SegmentEnd::kNone ? 0 : (r.evaluations > 0U ? 1 : (r.work_cells > 0U ? 2 : 3));
     cpu_max_by_kind[kind] = std::max(cpu_max_by_kind[kind], cpu);
     double& split = r.bottom.status == StepResult::Status::kProcessed ? cpu_max_bottom_processed : cpu_max_bottom_idle;
