@@ -592,36 +592,26 @@ void SdpSlamImpl::make_room_now(std::uint64_t need) {
 
 // A permanent level's tree goes whole: its other submaps are released (prune frees
 // their lineages and folds the rest into the chosen one), and the chosen submap is
-// copied into the global map and released. Several levels' work may be pending (queued
-// releases, the copy in progress, queued copies): the observations of all their trees.
+// copied into the global map and released. Every level made permanent has one copy,
+// in progress or queued, and every path finishes a level's releases before its copy
+// starts, so the pending trees are those of the copies, one per level: their
+// observations are what the pending work gives back.
 std::uint64_t SdpSlamImpl::pending_release_observations() const {
   const AncestryTree& tree = filter_->tree();
   const DpMap& map = filter_->map();
-  // The pending nodes: queued releases, the copy in progress, queued copies.
-  NodeId copying = kNoNode;
-  CellRect rest;
-  if (!transfer_.pending(&copying, &rest)) copying = kNoNode;
-  const std::uint32_t total = release_count_ + 1U + copy_count_;
-  const auto pending_node = [&](std::uint32_t k) {
-    if (k < release_count_) return release_queue_[k];
-    if (k == release_count_) return copying;
-    return copy_queue_[k - release_count_ - 1U].node;
-  };
-  std::uint64_t held = 0U;
-  for (std::uint32_t k = 0; k < total; ++k) {
-    const NodeId node = pending_node(k);
-    if (node == kNoNode || !tree.contains(node)) continue;
+  const auto tree_observations = [&](NodeId node) {
+    std::uint64_t held = 0U;
+    if (node == kNoNode || !tree.contains(node)) return held;
     const std::uint32_t sequence = tree.tree_sequence_unchecked(node);
-    bool counted = false;  // an earlier pending node of the same tree (a level's are adjacent)
-    for (std::uint32_t j = k; j > 0U && !counted; --j) {
-      const NodeId other = pending_node(j - 1U);
-      counted = other != kNoNode && tree.contains(other) && tree.tree_sequence_unchecked(other) == sequence;
-    }
-    if (counted) continue;
     for (NodeId n = 0U; n < tree.capacity(); ++n) {
       if (tree.contains(n) && tree.tree_sequence_unchecked(n) == sequence) held += map.observation_count(n);
     }
-  }
+    return held;
+  };
+  NodeId copying = kNoNode;
+  CellRect rest;
+  std::uint64_t held = transfer_.pending(&copying, &rest) ? tree_observations(copying) : 0U;
+  for (std::uint32_t k = 0; k < copy_count_; ++k) held += tree_observations(copy_queue_[k].node);
   return held;
 }
 
