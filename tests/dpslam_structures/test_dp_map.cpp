@@ -396,6 +396,99 @@ TEST(DpMap, observation_exhaustion_is_counted_and_leaves_views_unchanged) {
   CHECK_TRUE(view_is(f.map, c, 2, 0, obs(4, 0)));
 }
 
+// add_run() walks a run's cell lists side by side; the map must end exactly as with one
+// add() per cell in the same order: every arena byte (the same slots, links and values),
+// the same refusals and counters. On a bounded map, with runs that leave it, runs longer
+// than kMaxRun, and pools that run out; in a view (the side-by-side walk) and outside
+// one (one add() after the other).
+TEST(DpMap, add_run_ends_exactly_as_one_add_per_cell_in_order) {
+  for (std::uint32_t variant = 0U; variant < 4U; ++variant) {
+    const bool in_view = (variant & 1U) != 0U;
+    const bool short_pools = (variant & 2U) != 0U;
+    DpMap::Options o = small_options(short_pools ? 4U : 9U, short_pools ? 400U : 6000U);
+    o.owner_cell_index = false;  // views are taken without the index
+    DpFixture a(64U, 64U, o);
+    DpFixture b(64U, 64U, o);
+    sdpslam::test::SplitMix64 rng(17U + variant);
+    std::vector<NodeId> current{a.tree.create_root()};
+    LONGS_EQUAL(current[0], b.tree.create_root());
+    std::uint32_t refused = 0U;
+    std::uint32_t long_runs = 0U;
+    NodeId old = kNoNode;  // from generation 20 on, a particle of the older of two trees
+    for (std::uint32_t g = 0U; g < 40U; ++g) {
+      if (g == 20U) {  // a new tree (SDP-SLAM's next segment) while the old one still writes
+        old = current[0];
+        for (std::size_t k = 1U; k < current.size(); ++k) {
+          a.tree.set_active(current[k], false);
+          b.tree.set_active(current[k], false);
+        }
+        const NodeId root = a.tree.create_root();
+        LONGS_EQUAL(root, b.tree.create_root());
+        current.assign(1U, root);
+      }
+      std::vector<NodeId> next;
+      for (std::uint32_t k = 0U; k < 6U; ++k) {
+        const NodeId parent = current[rng.below(static_cast<std::uint32_t>(current.size()))];
+        const NodeId c = a.tree.add_child(parent);
+        LONGS_EQUAL(c, b.tree.add_child(parent));
+        next.push_back(c);
+      }
+      for (NodeId p : current) {
+        a.tree.set_active(p, false);
+        b.tree.set_active(p, false);
+      }
+      a.tree.prune(&a.map);
+      b.tree.prune(&b.map);
+      current.swap(next);
+      std::vector<NodeId> writers = current;
+      if (old != kNoNode) writers.push_back(old);
+      for (NodeId p : writers) {
+        if (in_view) {
+          a.map.begin_view(p);
+          b.map.begin_view(p);
+        }
+        for (std::uint32_t r = 0U; r < 3U; ++r) {
+          // A straight run of distinct cells from a random start, partly outside the map.
+          const std::uint32_t n = 1U + rng.below(2U * DpMap::kMaxRun);
+          if (n > DpMap::kMaxRun) ++long_runs;
+          std::int32_t dx = static_cast<std::int32_t>(rng.below(3U)) - 1;
+          const std::int32_t dy = static_cast<std::int32_t>(rng.below(3U)) - 1;
+          if (dx == 0 && dy == 0) dx = 1;
+          const std::int32_t x0 = static_cast<std::int32_t>(rng.below(56U)) - 4;
+          const std::int32_t y0 = static_cast<std::int32_t>(rng.below(48U)) - 4;
+          std::vector<DpMap::CellAdd> run(n);
+          std::uint32_t expected = 0U;
+          for (std::uint32_t i = 0U; i < n; ++i) {
+            const auto k = static_cast<std::int32_t>(i);
+            run[i] = DpMap::CellAdd{x0 + k * dx, y0 + k * dy, static_cast<std::uint16_t>(rng.below(3U)),
+                                    static_cast<std::uint16_t>(rng.below(3U))};
+            if (!a.map.add(p, run[i].ix, run[i].iy, run[i].hits, run[i].misses)) {
+              expected += static_cast<std::uint32_t>(run[i].hits) + run[i].misses;
+              ++refused;
+            }
+          }
+          LONGS_EQUAL(expected, b.map.add_run(p, run.data(), n));
+        }
+        a.map.end_view();
+        b.map.end_view();
+      }
+      CHECK_TRUE(a.buffer == b.buffer);
+      CHECK_TRUE(b.map.invariants_hold());
+      LONGS_EQUAL(a.map.observations_used(), b.map.observations_used());
+      LONGS_EQUAL(a.map.observations_peak(), b.map.observations_peak());
+      LONGS_EQUAL(a.map.tiles_used(), b.map.tiles_used());
+      LONGS_EQUAL(a.map.observation_oom_count(), b.map.observation_oom_count());
+      LONGS_EQUAL(a.map.tile_oom_count(), b.map.tile_oom_count());
+      LONGS_EQUAL(a.map.out_of_bounds_count(), b.map.out_of_bounds_count());
+      LONGS_EQUAL(a.map.observations_requested(), b.map.observations_requested());
+    }
+    CHECK(long_runs > 0U);
+    CHECK(a.map.out_of_bounds_count() > 0U);
+    if (short_pools) CHECK(a.map.observation_oom_count() + a.map.tile_oom_count() > 0U);
+    CHECK(refused > a.map.out_of_bounds_count() || !short_pools);
+  }
+}
+
 TEST(DpMap, tile_exhaustion_is_counted_and_existing_tiles_still_accept) {
   DpFixture f(8U, 8U, small_options(1U, 64U));
   const NodeId r = f.tree.create_root();

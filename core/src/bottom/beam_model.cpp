@@ -270,6 +270,21 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
     const std::int64_t dy = static_cast<std::int64_t>(iy) - t.ly;
     return dx >= -half && dx <= half && dy >= -half && dy <= half;
   };
+  // Both passes write in runs of distinct cells (DpMap::add_run(): their cell lists are
+  // walked side by side), in the order one add() per cell would take.
+  DpMap::CellAdd run[DpMap::kMaxRun];
+  std::uint32_t queued = 0U;
+  const auto queue = [&](std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
+    run[queued++] = DpMap::CellAdd{ix, iy, hits, misses};
+    if (queued == DpMap::kMaxRun) {
+      dropped += map.add_run(particle, run, queued);
+      queued = 0U;
+    }
+  };
+  const auto flush = [&] {
+    dropped += map.add_run(particle, run, queued);
+    queued = 0U;
+  };
   // Pass 1: sum the near square's writes (a cell outside the map goes to add(), which
   // counts each such write), then write each cell once, row by row.
   if (half >= 0) {
@@ -287,17 +302,28 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
       for (std::int32_t x = 0; x < side; ++x) {
         std::uint64_t& sum = scratch[static_cast<std::int64_t>(y) * side + x];
         if (sum == 0U) continue;
-        write(t.lx - half + x, t.ly - half + y, static_cast<std::uint16_t>(sum & 0xFFFFFFFFU),
+        queue(t.lx - half + x, t.ly - half + y, static_cast<std::uint16_t>(sum & 0xFFFFFFFFU),
               static_cast<std::uint16_t>(sum >> 32U));
         sum = 0U;
       }
     }
+    flush();
   }
-  // Pass 2: every beam's cells beyond the square, one add() per cell.
-  t.each_cell(*this, rays, [&](std::int32_t ix, std::int32_t iy, bool hit) {
-    if (!in_near(ix, iy)) write(ix, iy, hit ? 1U : 0U, hit ? 0U : 1U);
-    return true;
-  });
+  // Pass 2: every beam's cells beyond the square, one add() per cell, in runs of the
+  // beam's cells (distinct: Bresenham never visits a cell twice).
+  for (std::uint32_t b = 0; b < rays.count; ++b) {
+    std::int32_t ex;
+    std::int32_t ey;
+    bool hit;
+    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
+    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
+      if (in_near(ix, iy)) return true;
+      const bool h = last && hit;
+      queue(ix, iy, static_cast<std::uint16_t>(h ? 1U : 0U), static_cast<std::uint16_t>(h ? 0U : 1U));
+      return true;
+    });
+    flush();
+  }
   return dropped;
 }
 

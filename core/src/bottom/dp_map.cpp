@@ -8,6 +8,14 @@
 namespace sdpslam {
 
 namespace {
+// A hint that `p` is read soon (no effect on results); nothing where the compiler has none.
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) || defined(__clang__)
+  __builtin_prefetch(p);
+#else
+  (void)p;
+#endif
+}
 
 // Largest torus side (cells): far below 2^31, so that coordinates a window apart stay in
 // int32 wherever a lineage may draw.
@@ -462,6 +470,81 @@ bool DpMap::add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t
     }
   }
   return insert(particle, ti, c, accumulate(view, hits, misses));
+}
+
+std::uint32_t DpMap::add_run(NodeId particle, const CellAdd* adds, std::uint32_t count) {
+  std::uint32_t dropped = 0U;
+  const auto refused = [&](const CellAdd& a) { dropped += static_cast<std::uint32_t>(a.hits) + a.misses; };
+  if (particle != view_particle_ || tree_ == nullptr || !tree_->contains(particle)) {
+    for (std::uint32_t i = 0; i < count; ++i) {
+      if (!add(particle, adds[i].ix, adds[i].iy, adds[i].hits, adds[i].misses)) refused(adds[i]);
+    }
+    return dropped;
+  }
+  for (std::uint32_t first = 0; first < count; first += kMaxRun) {
+    const std::uint32_t n = count - first < kMaxRun ? count - first : kMaxRun;
+    const CellAdd* run = adds + first;
+    std::uint32_t ti[kMaxRun];
+    std::uint32_t c[kMaxRun];
+    std::uint32_t e[kMaxRun];      // the entry each walk is at, then its answer (find_marked_view())
+    std::uint32_t walking[kMaxRun];  // runs whose walk goes on
+    std::uint32_t active = 0U;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      e[i] = kNone;
+      if (!in_bounds(run[i].ix, run[i].iy)) continue;
+      ti[i] = tile_index(run[i].ix, run[i].iy);
+      c[i] = cell_in_tile(run[i].ix, run[i].iy);
+      const std::uint32_t slot = tile_table_[ti[i]];
+      if (slot != kNone) prefetch(&tiles_[slot].head[c[i]]);
+    }
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!in_bounds(run[i].ix, run[i].iy)) continue;
+      const std::uint32_t slot = tile_table_[ti[i]];
+      if (slot == kNone) continue;
+      e[i] = tiles_[slot].head[c[i]];
+      if (e[i] != kNone) {
+        prefetch(&obs_[e[i]]);
+        walking[active++] = i;
+      }
+    }
+    // find_marked_view() for every walk at once: a round takes one step of each.
+    while (active > 0U) {
+      std::uint32_t still = 0U;
+      for (std::uint32_t k = 0; k < active; ++k) {
+        const std::uint32_t i = walking[k];
+        const Observation& o = obs_[e[i]];
+        if (owner_mark_[o.owner] == view_mark_) continue;  // found: e[i] is the view
+        if (owner_tree_[o.owner] < view_tree_ || o.next_in_cell == kNone) {
+          e[i] = kNone;
+          continue;
+        }
+        e[i] = o.next_in_cell;
+        prefetch(&obs_[e[i]]);
+        walking[still++] = i;
+      }
+      active = still;
+    }
+    // add()'s tail, in order: the particle's own entry in place, else a new one.
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const CellAdd& a = run[i];
+      if (!in_bounds(a.ix, a.iy)) {
+        ++out_of_bounds_count_;
+        refused(a);
+        continue;
+      }
+      CellObservation view{};
+      if (e[i] != kNone) {
+        Observation& o = obs_[e[i]];
+        if (o.owner == node_owner_[particle]) {
+          o.value = accumulate(o.value, a.hits, a.misses);
+          continue;
+        }
+        view = o.value;
+      }
+      if (!insert(particle, ti[i], c[i], accumulate(view, a.hits, a.misses))) refused(a);
+    }
+  }
+  return dropped;
 }
 
 void DpMap::unlink_from_cell(std::uint32_t e) {

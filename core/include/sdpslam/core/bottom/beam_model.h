@@ -113,7 +113,9 @@ class BeamModel {
   // cells beyond are written as they come. The map ends the same: counts add, only the
   // order of first records in the pool differs. The near cells are written first, as a
   // scan's beams write them first without scratch, so that a pool that runs out drops
-  // far updates. Out-of-map writes count the same.
+  // far updates. Out-of-map writes count the same. Either way the adds go to the map in
+  // runs of distinct cells (the near square's, then each beam's), in the same order
+  // (DpMap::add_run(): their cell lists are walked side by side).
   std::uint32_t update_map(DpMap& map, NodeId particle, const ScanRays& rays, const Pose2& robot, double reach_m,
                            std::uint64_t* scratch) const;
   // The new observations one particle's update takes from the pool (its node is fresh)

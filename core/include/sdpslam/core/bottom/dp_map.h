@@ -40,7 +40,9 @@
 // Without the index (SDP-SLAM's few particles per segment) a scan's match and map update
 // for one particle run in a view (begin_view()): its ancestors' owners are marked once, and the
 // scan of each cell list tests per-owner tables (mark, tree sequence) instead of each
-// entry's node labels: one cache miss per entry walked instead of three.
+// entry's node labels: one cache miss per entry walked instead of three. A map update
+// writes its cells in runs (add_run()): the lists of a run's cells are walked side by
+// side, so that those misses overlap.
 //
 // Merge cost (TreeListener::on_node_merged, parent P into its only child C): if P owns
 // more observations than C, C's are moved into P's owner (where both have one in a
@@ -202,6 +204,24 @@ class DpMap final : public TreeListener {
   // current view plus the new evidence. Same result and failure rules as update(), with
   // one find_view() (whose answer, if the particle's own, is updated in place).
   bool add(NodeId particle, std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses);
+  // add() into a run of distinct cells, in order, with the same result as one add() per
+  // cell: the run's cell lists are walked side by side, one entry of each per round,
+  // with the next entry of each fetched ahead, so that their cache misses (one per entry
+  // walked, the cost of a map update) overlap instead of following one another. For the
+  // particle of begin_view() (another particle: one add() after the other). Cells must
+  // be distinct, and with wrap less than a window apart (a beam's traced cells are): an
+  // entry made for one cell is not looked for in the others. Returns the hits + misses
+  // of the adds refused (add() false).
+  struct CellAdd {
+    std::int32_t ix = 0;
+    std::int32_t iy = 0;
+    std::uint16_t hits = 0U;
+    std::uint16_t misses = 0U;
+  };
+  // Cells walked side by side (a longer run goes in parts): several times the misses a
+  // core keeps in flight, so that a round keeps them all busy.
+  static constexpr std::uint32_t kMaxRun = 64U;
+  std::uint32_t add_run(NodeId particle, const CellAdd* adds, std::uint32_t count);
   // A run of reads and add() calls for one particle (a scan's map update, a scan match)
   // between begin_view() and end_view(): begin_view() marks the owners of its
   // ancestors-or-self, O(depth), so that each lookup() or add() for it walks the cell
