@@ -235,16 +235,21 @@ struct BeamModel::Tracer {
   }
   // f(ix, iy, hit) for the cells of every traced beam, each beam from the laser's cell to
   // its end cell (hit: the end cell of a beam that ends in a hit); f returns false to
-  // stop tracing that beam.
-  template <class F>
-  void each_cell(const BeamModel& m, const ScanRays& rays, F&& f) const {
+  // stop tracing that beam. beam_done() follows each traced beam's cells.
+  template <class F, class Done>
+  void each_cell(const BeamModel& m, const ScanRays& rays, F&& f, Done&& beam_done) const {
     for (std::uint32_t b = 0; b < rays.count; ++b) {
       std::int32_t ex;
       std::int32_t ey;
       bool hit;
       if (!end_cell(m, rays, b, &ex, &ey, &hit)) continue;
       trace_cells(lx, ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) { return f(ix, iy, last && hit); });
+      beam_done();
     }
+  }
+  template <class F>
+  void each_cell(const BeamModel& m, const ScanRays& rays, F&& f) const {
+    each_cell(m, rays, f, [] {});
   }
 };
 
@@ -274,16 +279,13 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
   // walked side by side), in the order one add() per cell would take.
   DpMap::CellAdd run[DpMap::kMaxRun];
   std::uint32_t queued = 0U;
-  const auto queue = [&](std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
-    run[queued++] = DpMap::CellAdd{ix, iy, hits, misses};
-    if (queued == DpMap::kMaxRun) {
-      dropped += map.add_run(particle, run, queued);
-      queued = 0U;
-    }
-  };
   const auto flush = [&] {
     dropped += map.add_run(particle, run, queued);
     queued = 0U;
+  };
+  const auto queue = [&](std::int32_t ix, std::int32_t iy, std::uint16_t hits, std::uint16_t misses) {
+    run[queued++] = DpMap::CellAdd{ix, iy, hits, misses};
+    if (queued == DpMap::kMaxRun) flush();
   };
   // Pass 1: sum the near square's writes (a cell outside the map goes to add(), which
   // counts each such write), then write each cell once, row by row.
@@ -311,19 +313,13 @@ std::uint32_t BeamModel::update_map(DpMap& map, NodeId particle, const ScanRays&
   }
   // Pass 2: every beam's cells beyond the square, one add() per cell, in runs of the
   // beam's cells (distinct: Bresenham never visits a cell twice).
-  for (std::uint32_t b = 0; b < rays.count; ++b) {
-    std::int32_t ex;
-    std::int32_t ey;
-    bool hit;
-    if (!t.end_cell(*this, rays, b, &ex, &ey, &hit)) continue;
-    trace_cells(t.lx, t.ly, ex, ey, [&](std::int32_t ix, std::int32_t iy, bool last) {
-      if (in_near(ix, iy)) return true;
-      const bool h = last && hit;
-      queue(ix, iy, static_cast<std::uint16_t>(h ? 1U : 0U), static_cast<std::uint16_t>(h ? 0U : 1U));
-      return true;
-    });
-    flush();
-  }
+  t.each_cell(
+      *this, rays,
+      [&](std::int32_t ix, std::int32_t iy, bool hit) {
+        if (!in_near(ix, iy)) queue(ix, iy, hit ? 1U : 0U, hit ? 0U : 1U);
+        return true;
+      },
+      flush);
   return dropped;
 }
 

@@ -484,24 +484,26 @@ std::uint32_t DpMap::add_run(NodeId particle, const CellAdd* adds, std::uint32_t
   for (std::uint32_t first = 0; first < count; first += kMaxRun) {
     const std::uint32_t n = count - first < kMaxRun ? count - first : kMaxRun;
     const CellAdd* run = adds + first;
+    bool inside[kMaxRun];
     std::uint32_t ti[kMaxRun];
     std::uint32_t c[kMaxRun];
-    std::uint32_t e[kMaxRun];      // the entry each walk is at, then its answer (find_marked_view())
+    std::uint32_t slot[kMaxRun];     // kNone: no tile yet (or outside)
+    std::uint32_t e[kMaxRun];        // the entry each walk is at, then its answer (find_marked_view())
     std::uint32_t walking[kMaxRun];  // runs whose walk goes on
     std::uint32_t active = 0U;
     for (std::uint32_t i = 0; i < n; ++i) {
       e[i] = kNone;
-      if (!in_bounds(run[i].ix, run[i].iy)) continue;
+      slot[i] = kNone;
+      inside[i] = in_bounds(run[i].ix, run[i].iy);
+      if (!inside[i]) continue;
       ti[i] = tile_index(run[i].ix, run[i].iy);
       c[i] = cell_in_tile(run[i].ix, run[i].iy);
-      const std::uint32_t slot = tile_table_[ti[i]];
-      if (slot != kNone) prefetch(&tiles_[slot].head[c[i]]);
+      slot[i] = tile_table_[ti[i]];
+      if (slot[i] != kNone) prefetch(&tiles_[slot[i]].head[c[i]]);
     }
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (!in_bounds(run[i].ix, run[i].iy)) continue;
-      const std::uint32_t slot = tile_table_[ti[i]];
-      if (slot == kNone) continue;
-      e[i] = tiles_[slot].head[c[i]];
+      if (slot[i] == kNone) continue;
+      e[i] = tiles_[slot[i]].head[c[i]];
       if (e[i] != kNone) {
         prefetch(&obs_[e[i]]);
         walking[active++] = i;
@@ -527,7 +529,7 @@ std::uint32_t DpMap::add_run(NodeId particle, const CellAdd* adds, std::uint32_t
     // add()'s tail, in order: the particle's own entry in place, else a new one.
     for (std::uint32_t i = 0; i < n; ++i) {
       const CellAdd& a = run[i];
-      if (!in_bounds(a.ix, a.iy)) {
+      if (!inside[i]) {
         ++out_of_bounds_count_;
         refused(a);
         continue;
