@@ -165,7 +165,10 @@ LogReader::Next parse_flaser(const Fields& f, bool rear, const LogReaderOptions&
       !parse_trailer(f, &laser->stamp_us, &laser->logger_stamp_us, reason)) {
     return LogReader::Next::kEnd;
   }
-  // Beams evenly over 180 deg from -90 deg (README "CARMEN line formats").
+  // Beams evenly over 180 deg from -90 deg (README "CARMEN line formats"). CARMEN's own
+  // reader (src/logger/readlog.c, carmen_laser_guess_angle_increment) takes 1 deg for 180
+  // beams and 0.5 deg for 360, the scanner's last beam dropped; tools/bench/laser_spacing.py
+  // measures which spacing a log's scans agree with.
   scan.geometry.angle_min_rad = static_cast<float>(-kPi / 2.0);
   scan.geometry.angle_increment_rad = static_cast<float>(kPi / static_cast<double>(n - 1));
   scan.geometry.range_min_m = 0.0F;
