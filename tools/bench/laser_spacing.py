@@ -173,7 +173,6 @@ def register(a_pts, b_pts, guess, iterations=25):
         th = math.atan2(sxy, sxx)
         c, s = math.cos(th), math.sin(th)
         x, y = max_ - (c * mbx - s * mby), may - (s * mbx + c * mby)
-    c, s = math.cos(th), math.sin(th)
     total, count = 0.0, 0
     for bx, by in b_pts:
         qx, qy = x + c * bx - s * by, y + s * bx + c * by
@@ -217,23 +216,26 @@ def main(argv):
     else:
         pairs = pairs_from_odometry(scans, min_turn, args.min_travel_m, args.max_gap_s, args.pairs)
     if not pairs:
-        sys.exit("%s: no pair of scans turned %.1f deg apart" % (args.log, args.min_turn_deg))
+        sys.exit("%s: no pair of scans turned %.1f deg apart%s" % (
+            args.log, args.min_turn_deg, "" if args.relations else " and moved %.2f m" % args.min_travel_m))
 
-    nominal = 180.0 / n
-    candidates = {
-        "evenly over 180 deg, 180/(n-1) (sdpslam's reader)": 180.0 / (n - 1),
-        "CARMEN readlog.c": {180: 1.0, 181: 1.0, 360: 0.5, 361: 0.5, 400: 0.25, 401: 0.25}.get(n, 180.0 / (n - 1)),
-    }
-    for f in (0.988, 0.992, 0.996, 1.004, 1.008, 1.012):
-        candidates["180/n x %.3f" % f] = nominal * f
+    # Candidate spacings (deg) and their names; one spacing that two conventions share
+    # (181 and 361 beams) is one row named after both.
+    reader_deg = 180.0 / (n - 1)
+    carmen_deg = {180: 1.0, 181: 1.0, 360: 0.5, 361: 0.5, 400: 0.25, 401: 0.25}.get(n, reader_deg)
+    named = [(reader_deg, "evenly over 180 deg, 180/(n-1) (sdpslam's reader)"), (carmen_deg, "CARMEN readlog.c")]
+    named += [(180.0 / n * f, "180/n x %.3f" % f) for f in (0.988, 0.992, 0.996, 1.004, 1.008, 1.012)]
+    candidates = {}
+    for increment_deg, name in named:
+        candidates[increment_deg] = candidates[increment_deg] + "; " + name if increment_deg in candidates else name
     print("%s: %d beams per scan, %d scan pairs turned %.0f deg or more apart (%s)"
           % (args.log, n, len(pairs), args.min_turn_deg, "relations" if args.relations else "odometry"))
     if "laser_front_laser_resolution" in params:
         print("the log's PARAM laser_front_laser_resolution: %s deg" % params["laser_front_laser_resolution"])
     # Every candidate is judged on the same pairs: those registered under all of them.
-    ordered = sorted(candidates.items(), key=lambda kv: kv[1])
+    ordered = sorted(candidates.items())
     residuals = []
-    for _, increment_deg in ordered:
+    for increment_deg, _ in ordered:
         inc = math.radians(increment_deg)
         residuals.append([register(points(scans[i][1], inc), points(scans[j][1], inc), guess)
                           for i, j, guess in pairs])
@@ -243,9 +245,9 @@ def main(argv):
     # Paired differences against the reader's spacing: the pairs differ far more from one
     # another than the candidates do, so each candidate's mean is compared pair by pair,
     # with the standard error of that mean difference.
-    reader = [k for k, (name, _) in enumerate(ordered) if "sdpslam" in name][0]
+    reader = [increment_deg for increment_deg, _ in ordered].index(reader_deg)
     rows = []
-    for (name, increment_deg), r in zip(ordered, residuals):
+    for (increment_deg, name), r in zip(ordered, residuals):
         mean = sum(r[k] for k in common) / len(common)
         diffs = [r[k] - residuals[reader][k] for k in common]
         d = sum(diffs) / len(diffs)
