@@ -86,6 +86,9 @@ bool SdpSlam::level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* i
   return impl().level_origin(level, stamp_us, initial);
 }
 bool SdpSlam::level_held(std::uint32_t level) const { return impl().level_held(level); }
+bool SdpSlam::current_segment(std::uint32_t* level, std::int64_t* start_stamp_us) const {
+  return impl().current_segment(level, start_stamp_us);
+}
 std::size_t SdpSlam::arena_bytes_used() const { return impl().arena_bytes_used(); }
 void SdpSlam::top_error(double* mean_m, double* std_m, std::uint32_t* count) const {
   impl().top_error(mean_m, std_m, count);

@@ -71,6 +71,12 @@ class SdpSlamImpl {
 
   const LoopClosure& loop_closure() const { return loop_closure_; }
   bool level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const;
+  bool current_segment(std::uint32_t* level, std::int64_t* start_stamp_us) const {
+    if (!initialised_ || !started_) return false;
+    *level = graph_.level_end();
+    *start_stamp_us = segment_start_stamp_us_;
+    return true;
+  }
   bool level_held(std::uint32_t level) const {
     std::uint32_t index = 0U;
     return graph_index(level, &index);

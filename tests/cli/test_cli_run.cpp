@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -500,6 +501,32 @@ TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
   STRCMP_CONTAINS(" loops.tsv\n", text_of(dir + "/run/manifest.txt").c_str());
   CHECK_TRUE(lines_in(dir + "/run/loops.tsv") >= 2U);
+  // segments.tsv: one line per level and one for the segment being mapped at the end,
+  // each level starting where loops.tsv says it did.
+  STRCMP_CONTAINS(" segments.tsv\n", text_of(dir + "/run/manifest.txt").c_str());
+  std::map<std::string, std::string> starts;
+  {
+    std::istringstream in(text_of(dir + "/run/segments.tsv"));
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream f(line);
+      std::string level, stamp, extra;
+      CHECK_TEXT(static_cast<bool>(f >> level >> stamp) && !(f >> extra), line.c_str());
+      starts[level] = stamp;
+    }
+  }
+  {
+    std::istringstream in(text_of(dir + "/run/loops.tsv"));
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream f(line);
+      std::vector<std::string> c;
+      for (std::string t; f >> t;) c.push_back(t);
+      LONGS_EQUAL_TEXT(16U, c.size(), line.c_str());
+      STRCMP_EQUAL_TEXT(starts[c[0]].c_str(), c[8].c_str(), line.c_str());
+      STRCMP_EQUAL_TEXT(starts[c[1]].c_str(), c[12].c_str(), line.c_str());
+    }
+  }
   r = run_cli("evaluate --loops " + dir + "/run/loops.tsv --ground-truth " + dir + "/sim/ground_truth.txt --json " +
               dir + "/loops.json");
   LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
@@ -518,6 +545,7 @@ TEST(CliRun, the_loop_constraints_are_written_with_their_levels_origins) {
   CHECK_TRUE(lc["adjustments_capped"].is_number_unsigned());
   CHECK(lc["adjustments"].get<std::uint64_t>() > 0U);
   CHECK(lc["adjustments_capped"].get<std::uint64_t>() <= lc["adjustments"].get<std::uint64_t>());
+  LONGS_EQUAL(stats["segments"].get<std::size_t>() + 1U, starts.size());
 }
 
 // `sdpslam localize` on a simulated world's own map, from the ground truth's first pose:

@@ -274,6 +274,12 @@ class SdpSlam {
   SdpLoopRecord loop_record(std::uint32_t k) const;
   bool level_origin(std::uint32_t level, std::int64_t* stamp_us, Pose2* initial) const;
   bool level_held(std::uint32_t level) const;
+  // The segment being mapped now: the level it becomes when it ends (every level below
+  // it was made before) and the stamp it started at, as level_origin() gives for a
+  // level (one microsecond before the first scan for the first segment). Level l holds
+  // the scans after its start stamp up to the next level's start stamp, included. False
+  // before the first processed scan.
+  bool current_segment(std::uint32_t* level, std::int64_t* start_stamp_us) const;
   std::size_t arena_bytes_used() const;
   // Mean/std of the ICP error over the top-level particles that have one (0 if none).
   void top_error(double* mean_m, double* std_m, std::uint32_t* count) const;

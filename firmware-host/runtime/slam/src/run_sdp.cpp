@@ -281,6 +281,7 @@ SdpRunStatus run_sdp_offline(const std::string& log_path, const SdpRunOptions& o
   }
   if (!io::write_file_atomic(outputs.path("icp_error.csv"), csv, error)) return SdpRunStatus::kIoError;
   if (!io::write_file_atomic(outputs.path("loops.tsv"), sdp_loops_tsv(slam), error)) return SdpRunStatus::kIoError;
+  if (!io::write_file_atomic(outputs.path("segments.tsv"), sdp_segments_tsv(slam), error)) return SdpRunStatus::kIoError;
   const io::Chart chart = error_chart(session.rounds(), scans.front().stamp_us);
   if (io::chart_has_data(chart) && !options.painter.chart(outputs.path("icp_error.png"), chart, error)) {
     return SdpRunStatus::kIoError;

@@ -267,6 +267,20 @@ std::string sdp_loops_tsv(const SdpSlam& slam) {
   return out;
 }
 
+std::string sdp_segments_tsv(const SdpSlam& slam) {
+  std::string out = "# sdpslam segments: level start_stamp (s); a level holds the scans after its start up to the next start\n";
+  std::uint32_t current = 0U;
+  std::int64_t current_start_us = 0;
+  if (!slam.current_segment(&current, &current_start_us)) return out;
+  for (std::uint32_t level = 0; level <= current; ++level) {
+    std::int64_t start_us = current_start_us;
+    Pose2 initial;
+    if (level < current && !slam.level_origin(level, &start_us, &initial)) continue;
+    out += std::to_string(level) + " " + io::format_stamp_us(start_us) + "\n";
+  }
+  return out;
+}
+
 io::Json sdp_state_json(const SdpSlam& slam, std::size_t arena_bytes, std::size_t arena_used_bytes,
                         std::uint64_t path_gaps, std::uint32_t known_cells) {
   const DpSlamFilter& bottom = slam.bottom();

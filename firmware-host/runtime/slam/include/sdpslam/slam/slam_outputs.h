@@ -139,6 +139,17 @@ std::vector<io::StampedPose> sdp_best_path(const SdpSlam& slam, const SdpPermane
 // level whose origin is no longer held has stamp "-" and zero pose.
 std::string sdp_loops_tsv(const SdpSlam& slam);
 
+// segments.tsv: the segments of the path, one per line, oldest first: the level each
+// became (the current one: the level it will become) and the stamp it started at
+// (SdpSlam::level_origin, SdpSlam::current_segment):
+//   level start_stamp
+// A level holds the scans after its start stamp up to the next line's start stamp,
+// included, so that `sdpslam evaluate --segments` can tell the relations within one
+// submap from those across two (eval/frame_fit.h). Levels no longer held (forgotten
+// permanent levels) are left out: their scans count with the line before. Stamps in
+// seconds (six decimals). Empty of lines before the first processed scan.
+std::string sdp_segments_tsv(const SdpSlam& slam);
+
 // The best combination's global map (paper Fig. 3 (j)-(l)), rendered through the core's
 // API (SdpSlam::global_map_grid, for_each_global_cell): the permanent map (each cell
 // moved with its level's frame as loop closure corrected it) plus each chosen submap's
