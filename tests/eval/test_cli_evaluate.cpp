@@ -123,6 +123,44 @@ TEST(CliEvaluate, the_worst_relation_is_named_with_its_stamps) {
   CHECK_TRUE(s[2]["to_s"].is_null());
 }
 
+// With the run's segments, each segment's frame is fitted to the relations: the scan of
+// the second segment sits 0.5 m too far, which its frame takes back whole.
+TEST(CliEvaluate, segment_frames_fitted_to_the_relations_say_what_their_placement_costs) {
+  const std::string json = dir + "/out.json";
+  const std::string t = put("t.txt", "10.000000 0 0 0\n11.000000 1 0 0\n12.000000 2.5 0 0\n");
+  const std::string seg = put("l.tsv", "# level start\n0 9.999999\n1 11.000000\n");
+  const Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --segments " +
+                             seg + " --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS(": 2; each segment's frame fitted rigidly to the relations (1 moved)", r.out.c_str());
+  STRCMP_CONTAINS("within a segment     1 relations, mean 0.000 m as estimated, 0.000 m with the fitted frames",
+                  r.out.c_str());
+  STRCMP_CONTAINS("across segments      1 relations, mean 0.500 m as estimated, 0.000 m with the fitted frames",
+                  r.out.c_str());
+  STRCMP_CONTAINS("the frames' placement accounts for 0.250 m of the mean", r.out.c_str());
+  const nlohmann::json f = json_of(json)["relations"]["frame_fit"];
+  LONGS_EQUAL(1, f["across"]["count"].get<int>());
+  DOUBLES_EQUAL(0.5, f["across"]["mean_m"].get<double>(), 1e-9);
+  DOUBLES_EQUAL(0.0, f["across"]["fitted_mean_m"].get<double>(), 1e-6);
+  DOUBLES_EQUAL(0.5, f["correction_max_m"].get<double>(), 1e-6);
+  // Without --segments the JSON says there was no fit.
+  const Run plain = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --json " +
+                                 json);
+  LONGS_EQUAL_TEXT(0, plain.status, plain.out.c_str());
+  CHECK_TRUE(json_of(json)["relations"]["frame_fit"].is_null());
+}
+
+TEST(CliEvaluate, segments_need_a_trajectory_and_a_well_formed_file) {
+  const std::string seg = put("l.tsv", "0 9.999999\n1 oops\n");
+  Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --odometry --segments " + seg);
+  LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
+  STRCMP_CONTAINS("--segments needs --relations and --trajectory", r.out.c_str());
+  const std::string t = put("t.txt", "10.000000 0 0 0\n");
+  r = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --segments " + seg);
+  LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
+  STRCMP_CONTAINS((seg + ":2: bad start stamp 'oops'").c_str(), r.out.c_str());
+}
+
 TEST(CliEvaluate, sparse_trajectory_is_filled_with_odometry) {
   // Only the first scan estimated: the rest comes from odometry, so figures equal the
   // odometry's.

@@ -5,7 +5,10 @@
 //       The log supplies the laser stamps and the odometry pose at every scan: scans the
 //       trajectory has no pose for are filled with the last estimate composed with
 //       odometry (tools/eval/include/sdpslam/eval/relations.h). --odometry evaluates the
-//       log's own odometry poses (the "raw odometry" baseline).
+//       log's own odometry poses (the "raw odometry" baseline). With --segments (a
+//       run's segments.tsv) it also fits each segment's frame rigidly to the relations
+//       and says how much of the error the frames' placement accounts for
+//       (tools/eval/include/sdpslam/eval/frame_fit.h).
 //   sdpslam evaluate --trajectory TRAJ --ground-truth GT [--rpe-m D]
 //       absolute trajectory error after the best SE(2) alignment, and the relative
 //       error over every D metres of the ground-truth path (default 10; 0 = not measured):
@@ -34,6 +37,7 @@
 
 #include "cli_common.h"
 #include "sdpslam/eval/ate.h"
+#include "sdpslam/eval/frame_fit.h"
 #include "sdpslam/eval/log_scans.h"
 #include "sdpslam/eval/loops.h"
 #include "sdpslam/eval/map_agreement.h"
@@ -67,6 +71,7 @@ struct EvaluateArgs {
   std::string loops_path;
   std::string json_path;
   std::string plot_path;
+  std::string segments_path;
   bool odometry = false;
   double rpe_m = 10.0;
   std::int64_t tolerance_us = eval::kDefaultStampToleranceUs;
@@ -241,6 +246,45 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                                {"scale_error", c.scale_measured ? io::Json(c.scale_error) : io::Json(nullptr)}});
   }
 
+  io::Json frame_fit = nullptr;
+  if (!a.segments_path.empty()) {
+    std::vector<eval::SegmentStart> segments;
+    if (!eval::read_segments(a.segments_path, &segments, &error)) {
+      std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+      return kExitBadInput;
+    }
+    if (segments.empty()) {
+      std::fprintf(stderr, "sdpslam evaluate: %s: no segments\n", a.segments_path.c_str());
+      return kExitBadInput;
+    }
+    const eval::FrameFitResult f = eval::fit_segment_frames(relations, per_scan, segments, a.tolerance_us);
+    std::printf("  segments    %s: %zu; each segment's frame fitted rigidly to the relations (%zu moved)\n",
+                a.segments_path.c_str(), segments.size(), f.segments_moved);
+    const auto part = [](const char* name, const eval::FrameFitPart& p) {
+      std::printf("  %-22s %zu relations, mean %.3f m as estimated, %.3f m with the fitted frames\n", name, p.count,
+                  p.mean_m, p.fitted_mean_m);
+    };
+    part("  all", f.all);
+    part("  within a segment", f.within);
+    part("  across segments", f.across);
+    std::printf("  frame fit   corrections: median %.3f m and %.2f deg, largest %.3f m; the frames' placement "
+                "accounts for %.3f m of the mean\n",
+                f.correction_median_m, f.correction_median_deg, f.correction_max_m, f.all.mean_m - f.all.fitted_mean_m);
+    const auto part_json = [](const eval::FrameFitPart& p) {
+      return io::Json{{"count", p.count}, {"mean_m", p.mean_m}, {"fitted_mean_m", p.fitted_mean_m}};
+    };
+    frame_fit = io::Json{{"segments_file", a.segments_path},
+                         {"segment_count", segments.size()},
+                         {"segments_moved", f.segments_moved},
+                         {"all", part_json(f.all)},
+                         {"within", part_json(f.within)},
+                         {"across", part_json(f.across)},
+                         {"correction_median_m", f.correction_median_m},
+                         {"correction_median_deg", f.correction_median_deg},
+                         {"correction_max_m", f.correction_max_m},
+                         {"steps", f.steps}};
+  }
+
   (*json)["relations"] = {{"file", a.relations_path},
                           {"log", a.log_path},
                           {"trajectory", a.odometry ? std::string("odometry") : a.trajectory_path},
@@ -256,7 +300,8 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                           {"rotation_deg", json_stats(res.rotation_deg)},
                           {"rotation_deg2", json_stats(res.rotation_deg2)},
                           {"worst", worst},
-                          {"by_span", by_span}};
+                          {"by_span", by_span},
+                          {"frame_fit", frame_fit}};
   if (res.used_count == 0) {
     std::fprintf(stderr, "sdpslam evaluate: no relation of %s matches the scans of %s\n", a.relations_path.c_str(),
                  a.log_path.c_str());
@@ -444,6 +489,10 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --rpe-m must be a distance in metres, 0 .. 1e6 (0: not measured)\n");
     return kExitUsage;
   }
+  if (!a.segments_path.empty() && (!want_relations || a.trajectory_path.empty())) {
+    std::fprintf(stderr, "sdpslam evaluate: --segments needs --relations and --trajectory\n");
+    return kExitUsage;
+  }
   if (!a.plot_path.empty() && !want_relations) {
     std::fprintf(stderr, "sdpslam evaluate: --plot needs --relations\n");
     return kExitUsage;
@@ -495,6 +544,9 @@ std::function<int()> setup_evaluate(CLI::App& app) {
   app.add_option("--json", args->json_path, "also write the figures to this JSON file");
   app.add_option("--plot", args->plot_path,
                  "with --relations: draw each relation's translational error over time into this PNG file");
+  app.add_option("--segments", args->segments_path,
+                 "with --relations and --trajectory: the run's segments.tsv; fit each segment's frame to the relations "
+                 "(how much of the error lies in the frames' placement, how much within the submaps)");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
                  "stamps closer than this name the same scan when not equal (default 1000)");
   return [args] { return run_evaluate(*args); };
