@@ -44,7 +44,7 @@ echo "finished after $kills kills and $resumes resumes ($attempt attempts)"
 [ "$kills" -gt 0 ] || { echo "FAIL: no attempt was killed: nothing was tested"; exit 1; }
 [ "$resumes" -gt 0 ] || { echo "FAIL: no attempt resumed: nothing was tested"; exit 1; }
 status=0
-for f in trajectory.txt trajectory.tum map.pgm map.yaml loops.tsv icp_error.csv; do
+for f in trajectory.txt trajectory.tum map.pgm map.yaml loops.tsv segments.tsv icp_error.csv; do
   if cmp -s "$work/whole/$f" "$work/resumed/$f"; then
     echo "same $f"
   else
