@@ -137,12 +137,12 @@ TEST(CliEvaluate, segment_frames_fitted_to_the_relations_say_what_their_placemen
                   r.out.c_str());
   STRCMP_CONTAINS("across segments      1 relations, mean 0.500 m as estimated, 0.000 m with the fitted frames",
                   r.out.c_str());
-  STRCMP_CONTAINS("the frames' placement accounts for 0.250 m of the mean", r.out.c_str());
+  STRCMP_CONTAINS("the frames' placement accounts for 0.250 m of the mean (", r.out.c_str());
   const nlohmann::json f = json_of(json)["relations"]["frame_fit"];
   LONGS_EQUAL(1, f["across"]["count"].get<int>());
   DOUBLES_EQUAL(0.5, f["across"]["mean_m"].get<double>(), 1e-9);
   DOUBLES_EQUAL(0.0, f["across"]["fitted_mean_m"].get<double>(), 1e-6);
-  DOUBLES_EQUAL(0.5, f["correction_max_m"].get<double>(), 1e-6);
+  CHECK_TRUE(f["converged"].get<bool>());
   // Without --segments the JSON says there was no fit.
   const Run plain = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --json " +
                                  json);

@@ -67,12 +67,13 @@ std::vector<SegmentStart> segments_of(const std::vector<StampedPose>& gt) {
 // Each segment's scans moved rigidly: turned about the segment's first scan and shifted,
 // by amounts that differ from segment to segment; plus, optionally, a deterministic
 // wobble of every scan (errors within the segments, which no frame can take away).
-std::vector<StampedPose> displaced(const std::vector<StampedPose>& gt, double wobble_m) {
+std::vector<StampedPose> displaced(const std::vector<StampedPose>& gt, double wobble_m, double frame_scale = 1.0) {
   std::vector<StampedPose> out = gt;
   for (std::size_t i = 0; i < gt.size(); ++i) {
     const std::size_t seg = i / kPerSegment;
     const double k = static_cast<double>(seg);
-    const Pose2 frame{0.05 * std::sin(1.3 * k), 0.04 * std::cos(0.7 * k), 0.01 * std::sin(2.1 * k + 0.5)};
+    const Pose2 frame{frame_scale * 0.05 * std::sin(1.3 * k), frame_scale * 0.04 * std::cos(0.7 * k),
+                      frame_scale * 0.01 * std::sin(2.1 * k + 0.5)};
     const Pose2 anchor = gt[seg * kPerSegment].pose;
     out[i].pose = anchor.compose(frame).compose(anchor.inverse().compose(gt[i].pose));
     out[i].pose.x_m += wobble_m * std::sin(0.9 * static_cast<double>(i));
@@ -100,24 +101,26 @@ TEST(FrameFit, rigidly_displaced_frames_are_put_back) {
   CHECK_TRUE(f.across.fitted_mean_m < 1.0e-4);
   DOUBLES_EQUAL(0.0, f.within.mean_m, 1.0e-9);
   DOUBLES_EQUAL(0.0, f.within.fitted_mean_m, 1.0e-9);
-  CHECK_TRUE(f.correction_max_m > 0.02);
+  CHECK_TRUE(f.converged);
 }
 
 // Errors within the segments stay: the fit leaves the relations within one segment as
-// they were, and cannot bring the error across segments below what the wobble makes.
+// they were; across segments it does at least as well as the true frames.
 TEST(FrameFit, errors_within_segments_stay) {
   const std::vector<StampedPose> gt = truth();
   const std::vector<Relation> rel = relations_of(gt);
   const std::vector<SegmentStart> seg = segments_of(gt);
-  const FrameFitResult rigid = sdpslam::eval::fit_segment_frames(rel, displaced(gt, 0.0), seg);
   const FrameFitResult f = sdpslam::eval::fit_segment_frames(rel, displaced(gt, 0.01), seg);
+  // The same wobble with every frame where it belongs: what the true placement scores.
+  const FrameFitResult placed = sdpslam::eval::fit_segment_frames(rel, displaced(gt, 0.01, 0.0), seg);
   CHECK_TRUE(f.within.mean_m > 0.005);
   DOUBLES_EQUAL(f.within.mean_m, f.within.fitted_mean_m, 1.0e-12);
   CHECK_TRUE(f.across.fitted_mean_m > 0.005);
   CHECK_TRUE(f.across.fitted_mean_m < f.across.mean_m);
   CHECK_TRUE(f.all.fitted_mean_m < f.all.mean_m);
-  // The frames it finds are those of the rigid case, to within the wobble's pull.
-  DOUBLES_EQUAL(rigid.correction_median_m, f.correction_median_m, 0.01);
+  // It places the frames at least as well as where they truly belong.
+  CHECK_TRUE(f.across.fitted_mean_m <= placed.across.mean_m + 1.0e-9);
+  CHECK_TRUE(f.across.mean_m > 2.0 * placed.across.mean_m);
 }
 
 // A run with one segment has nothing to place: every relation lies within it.

@@ -267,9 +267,8 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
     part("  all", f.all);
     part("  within a segment", f.within);
     part("  across segments", f.across);
-    std::printf("  frame fit   corrections: median %.3f m and %.2f deg, largest %.3f m; the frames' placement "
-                "accounts for %.3f m of the mean\n",
-                f.correction_median_m, f.correction_median_deg, f.correction_max_m, f.all.mean_m - f.all.fitted_mean_m);
+    std::printf("  frame fit   the frames' placement accounts for %.3f m of the mean (%u steps%s)\n",
+                f.all.mean_m - f.all.fitted_mean_m, f.steps, f.converged ? "" : ", not converged: the best placement may do better");
     const auto part_json = [](const eval::FrameFitPart& p) {
       return io::Json{{"count", p.count}, {"mean_m", p.mean_m}, {"fitted_mean_m", p.fitted_mean_m}};
     };
@@ -279,10 +278,8 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
                          {"all", part_json(f.all)},
                          {"within", part_json(f.within)},
                          {"across", part_json(f.across)},
-                         {"correction_median_m", f.correction_median_m},
-                         {"correction_median_deg", f.correction_median_deg},
-                         {"correction_max_m", f.correction_max_m},
-                         {"steps", f.steps}};
+                         {"steps", f.steps},
+                         {"converged", f.converged}};
   }
 
   (*json)["relations"] = {{"file", a.relations_path},

@@ -15,10 +15,9 @@
 namespace sdpslam::eval {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 constexpr double kConvergedM = 1.0e-10;   // a step that lowers the mean by less ends the fit
 constexpr double kWeightFloorM = 1.0e-3;  // IRLS: errors below 1 mm weigh as 1 mm
-constexpr std::uint32_t kMaxSteps = 200U;
+constexpr std::uint32_t kMaxSteps = 1000U;
 constexpr double kDerivativeStep = 1.0e-6;  // central differences, m and rad
 
 struct Point2D {
@@ -42,13 +41,6 @@ Pose2 corrected(const Pose2& p, const double* c, const Point2D& pivot) {
   const double x = p.x_m - pivot.x;
   const double y = p.y_m - pivot.y;
   return Pose2{pivot.x + cs * x - sn * y + c[0], pivot.y + sn * x + cs * y + c[1], p.heading_rad + c[2]};
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2U == 1U ? v[n / 2U] : 0.5 * (v[n / 2U - 1U] + v[n / 2U]);
 }
 
 // Solves A x = b for symmetric positive definite A (n × n, row-major), in place by
@@ -279,7 +271,7 @@ FrameFitResult fit_segment_frames(const std::vector<Relation>& relations, const 
         lambda *= 10.0;
       }
     }
-    if (!kept) break;
+    if (!kept) converged = true;  // no step lowers the mean: a minimum
   }
 
   auto part_add = [](FrameFitPart* p, double before, double after) {
@@ -301,16 +293,7 @@ FrameFitResult fit_segment_frames(const std::vector<Relation>& relations, const 
     p->mean_m /= static_cast<double>(p->count);
     p->fitted_mean_m /= static_cast<double>(p->count);
   }
-  std::vector<double> moved_m;
-  std::vector<double> turned_deg;
-  for (std::size_t s = 0; s < segments.size(); ++s) {
-    if (slot[s] == kFixed) continue;
-    moved_m.push_back(std::hypot(x[slot[s]], x[slot[s] + 1U]));
-    turned_deg.push_back(std::fabs(x[slot[s] + 2U]) * kRadToDeg);
-  }
-  res.correction_median_m = median(moved_m);
-  res.correction_max_m = moved_m.empty() ? 0.0 : *std::max_element(moved_m.begin(), moved_m.end());
-  res.correction_median_deg = median(turned_deg);
+  res.converged = converged;
   return res;
 }
 

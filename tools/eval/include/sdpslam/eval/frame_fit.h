@@ -19,6 +19,10 @@
 // 1 / max(|t(E)|, 1 mm): Weiszfeld's scheme for a sum of norms) with Levenberg–Marquardt
 // steps on the dense normal equations (3 unknowns per segment; a step is kept only when it
 // lowers the mean). Cost per step O(relations + (3 segments)³); deterministic.
+// The corrections themselves are not reported: they are relative to the gauge, so a
+// segment far along the path carries the drift of all those before it, and where the
+// relations leave a frame free (a stretch joined to the rest by its two ends only) any
+// placement along that freedom fits as well.
 //
 // Segments come from `sdpslam run`'s segments.tsv: "level start_stamp" per line, stamps
 // in seconds; level l holds the scans after its start stamp up to the next line's start
@@ -60,11 +64,11 @@ struct FrameFitResult {
   FrameFitPart all;
   FrameFitPart within;  // both scans in one segment (the fit cannot change these)
   FrameFitPart across;  // scans in two segments
-  // The corrections of the moved segments: at their mean scan position (m) and in heading.
-  double correction_median_m = 0.0;
-  double correction_max_m = 0.0;
-  double correction_median_deg = 0.0;
-  std::uint32_t steps = 0U;  // Levenberg–Marquardt steps taken (kept or not)
+  std::uint32_t steps = 0U;  // Levenberg–Marquardt steps taken
+  // The last kept step lowered the mean by less than 1e-10 m, or no step could lower it.
+  // False when the fit ran out of steps: the fitted means are then reached by some
+  // placement, but the best one may go lower.
+  bool converged = false;
 };
 
 // `per_scan` ascending by stamp (one pose per laser scan, as for evaluate_relations());
