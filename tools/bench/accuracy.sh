@@ -5,7 +5,10 @@
 #   - logs: `sdpslam run LOG --seed S`, then the relations metric (`sdpslam evaluate
 #     --relations`, mean absolute translational error, m), and the along-track scale
 #     error of the relations under 2 s apart (evaluate's local span class: whether the
-#     steps come out shorter or longer than the true ones, whatever the loops did);
+#     steps come out shorter or longer than the true ones, whatever the loops did), and
+#     how much of the mean the placement of the run's submaps accounts for (evaluate
+#     --segments: the mean less what it is once each segment's frame is fitted rigidly
+#     to the relations; the rest lies within the submaps);
 #   - worlds: `sdpslam simulate --world NAME --seed S` (the seed also draws the sensor
 #     noise, so each seed is a different simulated run), `sdpslam run --seed S` on it, then
 #     the absolute trajectory error against the simulator's ground truth (ATE RMSE after
@@ -76,6 +79,8 @@ if [ "${1:-}" = --job ]; then
   if [ "$status" = ok ]; then
     if [ "$kind" = log ]; then
       set -- --log "$log" --relations "$ACC_SHARED/datasets/$name.relations"
+      # sdp mode writes its segments: the frames' placement is measured too.
+      if [ -f "$dir/segments.tsv" ]; then set -- "$@" --segments "$dir/segments.tsv"; fi
     else
       set -- --ground-truth "$dir/sim/ground_truth.txt"
       # sdp mode writes its loop constraints: checked against the ground truth too.
@@ -125,12 +130,15 @@ if kind == "log":
     local = spans[0].get("scale_error")
     scale = "NA" if local is None else repr(local)
 used = ((ev or {}).get("loops") or {}).get("used") or {}
+fit = (((ev or {}).get("relations") or {}).get("frame_fit") or {}).get("all") or {}
+placement = repr(fit["mean_m"] - fit["fitted_mean_m"]) if "mean_m" in fit else "NA"
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
                  get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
                  get(rpe, "mean_m"), scale, get(used, "count"), get(used, "wrong"),
-                 get(obs, "writes_shortened"), get(obs, "shortest_write_reach_m"), get(t, "scans_cpu_over_100ms")]))
+                 get(obs, "writes_shortened"), get(obs, "shortest_write_reach_m"), get(t, "scans_cpu_over_100ms"),
+                 placement]))
 EOF
-  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' \
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' \
     "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
   mv "$dir/record.tsv.tmp" "$dir/record.tsv"
   value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
@@ -201,11 +209,11 @@ xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job 
 
 # runs.tsv in job order; a job that left no record counts as failed.
 runs="$out/runs.tsv"
-printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\twrites_shortened\tshortest_write_reach_m\tscans_cpu_over_100ms\n' > "$runs"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\twrites_shortened\tshortest_write_reach_m\tscans_cpu_over_100ms\tplacement_m\n' > "$runs"
 while read -r kind name seed; do
   rec="$out/${kind}s/$name/$seed/record.tsv"
   if [ -f "$rec" ]; then cat "$rec"; else
-    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
   fi
 done < "$joblist" >> "$runs"
 
@@ -222,9 +230,10 @@ def fmt(v, f):
     return "NA" if v is None else f % v
 def nums(rs, k):
     return [x for x in (num(r[k]) for r in rs) if x is not None]
-out = ["| name | metric | mean | worst (seed) | per seed | drift m per 10 m, mean (worst) | along-track % "
-       "| wrong loops used | CPU s mean | CPU s max | worst scan ms | scans over 100 ms | state bytes | peak RSS MiB | refusals |",
-       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+out = ["| name | metric | mean | worst (seed) | per seed | frames' placement m | drift m per 10 m, mean (worst) "
+       "| along-track % | wrong loops used | CPU s mean | CPU s max | worst scan ms | scans over 100 ms | state bytes "
+       "| peak RSS MiB | refusals |",
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for (kind, name), rs in groups.items():
     metric = "relations m" if kind == "log" else "ATE m"
     ok = [(num(r["value_m"]), r["seed"]) for r in rs if num(r["value_m"]) is not None]
@@ -249,10 +258,14 @@ for (kind, name), rs in groups.items():
     rpe, scale = nums(rs, "rpe_m"), nums(rs, "rpe_scale")
     drift = "-" if not rpe else "%.3f (%.3f)" % (sum(rpe) / len(rpe), max(rpe))
     along = "-" if not scale else "%+.2f" % (100.0 * sum(scale) / len(scale))
+    # The part of the relations error a rigid fit of the segments' frames takes away:
+    # what the submaps' placement (loop closure) costs, mean over the seeds.
+    place = nums(rs, "placement_m")
+    placement = "-" if not place else "%.3f" % (sum(place) / len(place))
     # Loop constraints used at the end that the ground truth says are 2 m or more off.
     used, wrong = nums(rs, "loops_used"), nums(rs, "loops_used_wrong")
     loops = "-" if not used else "%d of %d" % (sum(wrong), sum(used))
-    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, drift, along, loops,
+    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, placement, drift, along, loops,
         fmt(sum(cpu) / len(cpu) if cpu else None, "%.1f"), fmt(max(cpu) if cpu else None, "%.1f"),
         fmt(max(scan) if scan else None, "%.1f"), fmt(sum(slow) if slow else None, "%d"),
         fmt(max(arena) if arena else None, "%d"),
