@@ -5,12 +5,11 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <limits>
-#include <sstream>
 
 #include "sdpslam/eval/stamp_match.h"
+#include "sdpslam/io/text_table.h"
 
 namespace sdpslam::eval {
 namespace {
@@ -75,52 +74,34 @@ bool cholesky_solve(std::vector<double>& a, std::vector<double>& b, std::size_t 
 
 bool read_segments(const std::string& path, std::vector<SegmentStart>* segments, std::string* error) {
   segments->clear();
-  std::ifstream in(path);
-  if (!in) {
-    if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
-    return false;
-  }
-  return read_segments(in, path, segments, error);
+  std::ifstream in;
+  return io::open_for_reading(path, &in, error) && read_segments(in, path, segments, error);
 }
 
 bool read_segments(std::istream& in, const std::string& name, std::vector<SegmentStart>* segments,
                    std::string* error) {
   segments->clear();
-  std::string line;
-  std::int64_t line_no = 0;
-  auto fail = [&](const std::string& reason) {
-    if (error != nullptr) *error = name + ":" + std::to_string(line_no) + ": " + reason;
-    return false;
-  };
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
-    std::vector<std::string> tokens;
-    for (std::string t; fields >> t;) tokens.push_back(t);
-    if (tokens.size() != 2) return fail("expected 2 columns (level start_stamp), found " + std::to_string(tokens.size()));
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long level = std::strtoull(tokens[0].c_str(), &end, 10);
-    if (tokens[0].empty() || tokens[0][0] == '-' || *end != '\0' || errno == ERANGE ||
-        level > std::numeric_limits<std::uint32_t>::max()) {
-      return fail("bad level '" + tokens[0] + "'");
-    }
-    SegmentStart s;
-    s.level = static_cast<std::uint32_t>(level);
-    if (!io::parse_stamp_us(tokens[1], &s.start_us)) return fail("bad start stamp '" + tokens[1] + "'");
-    if (!segments->empty() && !(s.start_us > segments->back().start_us && s.level > segments->back().level)) {
-      return fail("level and start stamp must increase from line to line");
-    }
-    segments->push_back(s);
-  }
-  if (in.bad()) {
-    if (error != nullptr) *error = "read error on '" + name + "' after line " + std::to_string(line_no);
-    return false;
-  }
-  return true;
+  return io::read_table(
+      in, name,
+      [segments](const std::vector<std::string>& tokens, std::int64_t) -> std::string {
+        if (tokens.size() != 2) return "expected 2 columns (level start_stamp), found " + std::to_string(tokens.size());
+        char* end = nullptr;
+        errno = 0;
+        const unsigned long long level = std::strtoull(tokens[0].c_str(), &end, 10);
+        if (tokens[0].empty() || tokens[0][0] == '-' || *end != '\0' || errno == ERANGE ||
+            level > std::numeric_limits<std::uint32_t>::max()) {
+          return "bad level '" + tokens[0] + "'";
+        }
+        SegmentStart s;
+        s.level = static_cast<std::uint32_t>(level);
+        if (!io::parse_stamp_us(tokens[1], &s.start_us)) return "bad start stamp '" + tokens[1] + "'";
+        if (!segments->empty() && !(s.start_us > segments->back().start_us && s.level > segments->back().level)) {
+          return "level and start stamp must increase from line to line";
+        }
+        segments->push_back(s);
+        return std::string();
+      },
+      error);
 }
 
 std::size_t segment_of(const std::vector<SegmentStart>& segments, std::int64_t stamp_us) {

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "sdpslam/io/text_table.h"
+
 namespace sdpslam::eval {
 namespace {
 
@@ -28,52 +30,34 @@ bool parse_finite(const std::string& token, double* value) {
 
 bool read_relations(const std::string& path, std::vector<Relation>* relations, std::string* error) {
   relations->clear();
-  std::ifstream in(path);
-  if (!in) {
-    if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
-    return false;
-  }
-  return read_relations(in, path, relations, error);
+  std::ifstream in;
+  return io::open_for_reading(path, &in, error) && read_relations(in, path, relations, error);
 }
 
 bool read_relations(std::istream& in, const std::string& path, std::vector<Relation>* relations, std::string* error) {
   relations->clear();
-  std::string line;
-  std::int64_t line_no = 0;
-  auto fail = [&](const std::string& reason) {
-    if (error != nullptr) *error = path + ":" + std::to_string(line_no) + ": " + reason;
-    return false;
-  };
   static const char* const kColumns[] = {"t1", "t2", "x", "y", "z", "roll", "pitch", "yaw"};
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
-    std::vector<std::string> tokens;
-    for (std::string t; fields >> t;) tokens.push_back(t);
-    if (tokens.size() != 8) {
-      return fail("expected 8 columns (t1 t2 x y z roll pitch yaw), found " + std::to_string(tokens.size()));
-    }
-    Relation r;
-    r.line = line_no;
-    if (!io::parse_stamp_us(tokens[0], &r.t1_us)) return fail("bad timestamp t1 '" + tokens[0] + "'");
-    if (!io::parse_stamp_us(tokens[1], &r.t2_us)) return fail("bad timestamp t2 '" + tokens[1] + "'");
-    double v[6] = {};
-    for (std::size_t k = 2; k < 8; ++k) {
-      if (!parse_finite(tokens[k], &v[k - 2])) {
-        return fail(std::string("column ") + kColumns[k] + " '" + tokens[k] + "' is not a finite number");
-      }
-    }
-    r.expected = Pose2{v[0], v[1], normalize_angle_rad(v[5])};
-    relations->push_back(r);
-  }
-  if (in.bad()) {
-    if (error != nullptr) *error = "read error on '" + path + "' after line " + std::to_string(line_no);
-    return false;
-  }
-  return true;
+  return io::read_table(
+      in, path,
+      [relations](const std::vector<std::string>& tokens, std::int64_t line) -> std::string {
+        if (tokens.size() != 8) {
+          return "expected 8 columns (t1 t2 x y z roll pitch yaw), found " + std::to_string(tokens.size());
+        }
+        Relation r;
+        r.line = line;
+        if (!io::parse_stamp_us(tokens[0], &r.t1_us)) return "bad timestamp t1 '" + tokens[0] + "'";
+        if (!io::parse_stamp_us(tokens[1], &r.t2_us)) return "bad timestamp t2 '" + tokens[1] + "'";
+        double v[6] = {};
+        for (std::size_t k = 2; k < 8; ++k) {
+          if (!parse_finite(tokens[k], &v[k - 2])) {
+            return std::string("column ") + kColumns[k] + " '" + tokens[k] + "' is not a finite number";
+          }
+        }
+        r.expected = Pose2{v[0], v[1], normalize_angle_rad(v[5])};
+        relations->push_back(r);
+        return std::string();
+      },
+      error);
 }
 
 bool fill_with_odometry(const std::vector<io::StampedPose>& estimate, const std::vector<io::StampedPose>& scan_odometry,

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "sdpslam/io/atomic_file.h"
+#include "sdpslam/io/text_table.h"
 
 namespace sdpslam::io {
 namespace {
@@ -150,46 +151,29 @@ bool write_trajectory_tum(const std::string& path, const std::vector<StampedPose
 }
 
 bool read_trajectory(const std::string& path, std::vector<StampedPose>* poses, std::string* error) {
-  std::ifstream in(path);
-  if (!in) {
-    if (error != nullptr) *error = "cannot open '" + path + "': " + std::strerror(errno);
-    return false;
-  }
-  return read_trajectory(in, path, poses, error);
+  std::ifstream in;
+  return open_for_reading(path, &in, error) && read_trajectory(in, path, poses, error);
 }
 
 bool read_trajectory(std::istream& in, const std::string& path, std::vector<StampedPose>* poses, std::string* error) {
   std::vector<StampedPose> result;
-  std::string line;
-  std::int64_t line_no = 0;
   std::size_t columns_seen = 0;  // the first data line fixes the format for the file
-  auto fail = [&](const std::string& reason) {
-    if (error != nullptr) *error = path + ":" + std::to_string(line_no) + ": " + reason;
-    return false;
-  };
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
-    std::vector<std::string> tokens;
-    for (std::string t; fields >> t;) tokens.push_back(t);
+  const bool read = read_table(in, path, [&](const std::vector<std::string>& tokens, std::int64_t) -> std::string {
     if (tokens.size() != 4 && tokens.size() != 8) {
-      return fail("expected 4 columns (t x y theta) or 8 (TUM: t x y z qx qy qz qw), found " +
-                  std::to_string(tokens.size()));
+      return "expected 4 columns (t x y theta) or 8 (TUM: t x y z qx qy qz qw), found " +
+             std::to_string(tokens.size());
     }
     if (columns_seen == 0) columns_seen = tokens.size();
     if (tokens.size() != columns_seen) {
-      return fail("found " + std::to_string(tokens.size()) + " columns where earlier lines have " +
-                  std::to_string(columns_seen));
+      return "found " + std::to_string(tokens.size()) + " columns where earlier lines have " +
+             std::to_string(columns_seen);
     }
     StampedPose sp;
-    if (!parse_stamp_us(tokens[0], &sp.stamp_us)) return fail("bad timestamp '" + tokens[0] + "'");
+    if (!parse_stamp_us(tokens[0], &sp.stamp_us)) return "bad timestamp '" + tokens[0] + "'";
     double v[7] = {};
     for (std::size_t k = 1; k < tokens.size(); ++k) {
       if (!parse_double(tokens[k], &v[k - 1])) {
-        return fail("column " + std::to_string(k + 1) + " '" + tokens[k] + "' is not a finite number");
+        return "column " + std::to_string(k + 1) + " '" + tokens[k] + "' is not a finite number";
       }
     }
     sp.pose.x_m = v[0];
@@ -202,7 +186,7 @@ bool read_trajectory(std::istream& in, const std::string& path, std::vector<Stam
       double qz = v[5];
       double qw = v[6];
       const double scale = std::max({std::fabs(qx), std::fabs(qy), std::fabs(qz), std::fabs(qw)});
-      if (!(scale > 0.0)) return fail("zero quaternion");
+      if (!(scale > 0.0)) return "zero quaternion";
       // The yaw does not change with the quaternion's scale: huge or tiny components are
       // brought near 1 first, so that their squares neither overflow nor vanish.
       if (scale > 1e100 || scale < 1e-100) {
@@ -218,11 +202,9 @@ bool read_trajectory(std::istream& in, const std::string& path, std::vector<Stam
           normalize_angle_rad(std::atan2(2.0 * (qw * qz + qx * qy), norm2 - 2.0 * (qy * qy + qz * qz)));
     }
     result.push_back(sp);
-  }
-  if (in.bad()) {
-    if (error != nullptr) *error = "read error on '" + path + "' after line " + std::to_string(line_no);
-    return false;
-  }
+    return std::string();
+  }, error);
+  if (!read) return false;
   *poses = std::move(result);
   return true;
 }
