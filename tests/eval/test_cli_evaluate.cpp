@@ -154,11 +154,47 @@ TEST(CliEvaluate, segments_need_a_trajectory_and_a_well_formed_file) {
   const std::string seg = put("l.tsv", "0 9.999999\n1 oops\n");
   Run r = run_evaluate("--log " + log() + " --relations " + relations() + " --odometry --segments " + seg);
   LONGS_EQUAL_TEXT(2, r.status, r.out.c_str());
-  STRCMP_CONTAINS("--segments needs --relations and --trajectory", r.out.c_str());
+  STRCMP_CONTAINS("--segments needs --trajectory and --relations or --ground-truth", r.out.c_str());
   const std::string t = put("t.txt", "10.000000 0 0 0\n");
   r = run_evaluate("--log " + log() + " --relations " + relations() + " --trajectory " + t + " --segments " + seg);
   LONGS_EQUAL_TEXT(3, r.status, r.out.c_str());
   STRCMP_CONTAINS((seg + ":2: bad start stamp 'oops'").c_str(), r.out.c_str());
+}
+
+TEST(CliEvaluate, segments_against_a_ground_truth_split_placement_from_drift) {
+  // 20 m straight at 0.5 m per pose, in two segments. The first is exact but placed 1 m
+  // off; the second covers 90 % of each step from its first pose on.
+  std::string g;
+  std::string e;
+  for (int i = 0; i <= 40; ++i) {
+    g += std::to_string(i + 1) + " " + std::to_string(0.5 * i) + " 0 0\n";
+    const double x = i <= 20 ? 0.5 * i + 1.0 : 10.5 + 0.45 * (i - 21);
+    e += std::to_string(i + 1) + " " + std::to_string(x) + " 0 0\n";
+  }
+  const std::string gt = put("gt.txt", g);
+  const std::string t = put("t.txt", e);
+  const std::string seg = put("l.tsv", "0 0.999999\n1 21.000000\n");
+  const std::string json = dir + "/out.json";
+  const Run r = run_evaluate("--trajectory " + t + " --ground-truth " + gt + " --rpe-m 0 --segments " + seg +
+                             " --json " + json);
+  LONGS_EQUAL_TEXT(0, r.status, r.out.c_str());
+  STRCMP_CONTAINS(": 2, 2 measured over 19.5 m of path; each segment aligned on its own", r.out.c_str());
+  // Segment 1 ends 0.95 m short over a 9.5 m chord; segment 0 has no drift.
+  STRCMP_CONTAINS("drift       first to last scan of a segment: mean 0.475000 m, max 0.950000 m, 0.487179 m per 10 m",
+                  r.out.c_str());
+  STRCMP_CONTAINS("along-track scale -4.872 % (2 chords of 1 m or more)", r.out.c_str());
+  const nlohmann::json d = json_of(json)["segment_drift"];
+  LONGS_EQUAL(2, d["segments_measured"].get<int>());
+  DOUBLES_EQUAL(-0.95 / 19.5, d["along_track_scale"].get<double>(), 1e-12);
+  // Aligned on its own, the short segment keeps only its own error: well under the
+  // whole run's, which also carries the first segment's 1 m.
+  const double within = d["aligned_rmse_m"].get<double>();
+  CHECK_TRUE(within > 0.05);
+  CHECK_TRUE(within < json_of(json)["ate"]["rmse_m"].get<double>());
+  // --segments with the ground truth but no trajectory is a usage error.
+  const Run bad = run_evaluate("--loops " + seg + " --ground-truth " + gt + " --segments " + seg);
+  LONGS_EQUAL_TEXT(2, bad.status, bad.out.c_str());
+  STRCMP_CONTAINS("--segments needs --trajectory", bad.out.c_str());
 }
 
 TEST(CliEvaluate, sparse_trajectory_is_filled_with_odometry) {

@@ -9,10 +9,13 @@
 //       run's segments.tsv) it also fits each segment's frame rigidly to the relations
 //       and says how much of the error the frames' placement accounts for
 //       (tools/eval/include/sdpslam/eval/frame_fit.h).
-//   sdpslam evaluate --trajectory TRAJ --ground-truth GT [--rpe-m D]
+//   sdpslam evaluate --trajectory TRAJ --ground-truth GT [--rpe-m D] [--segments SEGMENTS.tsv]
 //       absolute trajectory error after the best SE(2) alignment, and the relative
 //       error over every D metres of the ground-truth path (default 10; 0 = not measured):
 //       the local drift, with the along-track scale error (tools/eval/include/sdpslam/eval/rpe.h).
+//       With --segments (a run's segments.tsv) also the error within the submaps: each
+//       segment aligned on its own, and each segment's drift from its first scan to its
+//       last (tools/eval/include/sdpslam/eval/segment_drift.h).
 //   sdpslam evaluate --loops LOOPS.tsv --ground-truth GT
 //       the loop constraints a run held (its loops.tsv) checked against the ground truth:
 //       how many were right (< 0.5 m), wrong (>= 2 m) or between, per source (the wide
@@ -43,6 +46,7 @@
 #include "sdpslam/eval/map_agreement.h"
 #include "sdpslam/eval/relations.h"
 #include "sdpslam/eval/rpe.h"
+#include "sdpslam/eval/segment_drift.h"
 #include "sdpslam/eval/stamp_match.h"
 #include "sdpslam/io/atomic_file.h"
 #include "sdpslam/io/json_text.h"
@@ -144,6 +148,20 @@ io::Chart relations_chart(const eval::RelationsResult& res, const std::string& s
   chart.series.push_back(each);
   chart.series.push_back(mean);
   return chart;
+}
+
+// A run's segments.tsv, not empty; kExitBadInput with file:line otherwise.
+int read_segments_file(const std::string& path, std::vector<eval::SegmentStart>* segments) {
+  std::string error;
+  if (!eval::read_segments(path, segments, &error)) {
+    std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
+    return kExitBadInput;
+  }
+  if (segments->empty()) {
+    std::fprintf(stderr, "sdpslam evaluate: %s: no segments\n", path.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
 }
 
 int run_relations(const EvaluateArgs& a, io::Json* json) {
@@ -249,14 +267,7 @@ int run_relations(const EvaluateArgs& a, io::Json* json) {
   io::Json frame_fit = nullptr;
   if (!a.segments_path.empty()) {
     std::vector<eval::SegmentStart> segments;
-    if (!eval::read_segments(a.segments_path, &segments, &error)) {
-      std::fprintf(stderr, "sdpslam evaluate: %s\n", error.c_str());
-      return kExitBadInput;
-    }
-    if (segments.empty()) {
-      std::fprintf(stderr, "sdpslam evaluate: %s: no segments\n", a.segments_path.c_str());
-      return kExitBadInput;
-    }
+    if (const int rc = read_segments_file(a.segments_path, &segments); rc != kExitOk) return rc;
     const eval::FrameFitResult f = eval::fit_segment_frames(relations, per_scan, segments, a.tolerance_us);
     std::printf("  segments    %s: %zu; each segment's frame fitted rigidly to the relations (%zu moved)\n",
                 a.segments_path.c_str(), segments.size(), f.segments_moved);
@@ -348,23 +359,55 @@ int run_ate(const EvaluateArgs& a, io::Json* json) {
          {"max_m", r.max_m},
          {"heading_rmse_deg", r.heading_rmse_rad * kRadToDeg},
          {"alignment", {{"x_m", r.alignment.x_m}, {"y_m", r.alignment.y_m}, {"heading_rad", r.alignment.heading_rad}}}};
-  if (!(a.rpe_m > 0.0)) return kExitOk;
   eval::RpeResult q;
-  if (!eval::compute_rpe(estimate, truth, a.tolerance_us, a.rpe_m, &q)) {
+  if (!(a.rpe_m > 0.0)) {
+    // not asked for
+  } else if (!eval::compute_rpe(estimate, truth, a.tolerance_us, a.rpe_m, &q)) {
     std::printf("  relative    not measured: the ground-truth path is shorter than %.3f m\n", a.rpe_m);
+  } else {
+    std::printf("  relative    over %zu stretches of %.3f m: mean %.6f m, rmse %.6f m, max %.6f m, heading %.6f deg, "
+                "along-track scale %+.3f %%\n",
+                q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
+                100.0 * q.scale_error);
+    (*json)["rpe"] = {{"distance_m", q.distance_m},
+                      {"stretch_count", q.stretch_count},
+                      {"mean_m", q.mean_m},
+                      {"rmse_m", q.rmse_m},
+                      {"max_m", q.max_m},
+                      {"heading_mean_deg", q.heading_mean_rad * kRadToDeg},
+                      {"scale_error", q.scale_error}};
+  }
+  if (a.segments_path.empty()) return kExitOk;
+  std::vector<eval::SegmentStart> segments;
+  if (const int rc = read_segments_file(a.segments_path, &segments); rc != kExitOk) return rc;
+  eval::SegmentDriftResult d;
+  if (!eval::measure_segment_drift(estimate, truth, segments, a.tolerance_us, &d)) {
+    std::printf("  segments    %s: %zu; not measured: no segment has two scans with ground truth\n",
+                a.segments_path.c_str(), segments.size());
+    (*json)["segment_drift"] = nullptr;
     return kExitOk;
   }
-  std::printf("  relative    over %zu stretches of %.3f m: mean %.6f m, rmse %.6f m, max %.6f m, heading %.6f deg, "
-              "along-track scale %+.3f %%\n",
-              q.stretch_count, q.distance_m, q.mean_m, q.rmse_m, q.max_m, q.heading_mean_rad * kRadToDeg,
-              100.0 * q.scale_error);
-  (*json)["rpe"] = {{"distance_m", q.distance_m},
-                    {"stretch_count", q.stretch_count},
-                    {"mean_m", q.mean_m},
-                    {"rmse_m", q.rmse_m},
-                    {"max_m", q.max_m},
-                    {"heading_mean_deg", q.heading_mean_rad * kRadToDeg},
-                    {"scale_error", q.scale_error}};
+  std::printf("  segments    %s: %zu, %zu measured over %.1f m of path; each segment aligned on its own\n",
+              a.segments_path.c_str(), segments.size(), d.segments_measured, d.path_m);
+  std::printf("  within      position rmse %.6f m, mean %.6f m (the placement of the segments accounts for the rest)\n",
+              d.aligned_rmse_m, d.aligned_mean_m);
+  std::printf("  drift       first to last scan of a segment: mean %.6f m, max %.6f m, %.6f m per 10 m of path, "
+              "heading %.6f deg, along-track scale %+.3f %% (%zu chords of %.0f m or more)\n",
+              d.endpoint_mean_m, d.endpoint_max_m, d.drift_per_10m_m, d.heading_mean_rad * kRadToDeg,
+              100.0 * d.along_track_scale, d.chords_measured, eval::kMinDriftChordM);
+  (*json)["segment_drift"] = {{"segments_file", a.segments_path},
+                              {"segment_count", segments.size()},
+                              {"segments_measured", d.segments_measured},
+                              {"scans_matched", d.scans_matched},
+                              {"path_m", d.path_m},
+                              {"aligned_rmse_m", d.aligned_rmse_m},
+                              {"aligned_mean_m", d.aligned_mean_m},
+                              {"endpoint_mean_m", d.endpoint_mean_m},
+                              {"endpoint_max_m", d.endpoint_max_m},
+                              {"drift_per_10m_m", d.drift_per_10m_m},
+                              {"heading_mean_deg", d.heading_mean_rad * kRadToDeg},
+                              {"chords_measured", d.chords_measured},
+                              {"along_track_scale", d.along_track_scale}};
   return kExitOk;
 }
 
@@ -486,8 +529,8 @@ int run_evaluate(const EvaluateArgs& a) {
     std::fprintf(stderr, "sdpslam evaluate: --rpe-m must be a distance in metres, 0 .. 1e6 (0: not measured)\n");
     return kExitUsage;
   }
-  if (!a.segments_path.empty() && (!want_relations || a.trajectory_path.empty())) {
-    std::fprintf(stderr, "sdpslam evaluate: --segments needs --relations and --trajectory\n");
+  if (!a.segments_path.empty() && ((!want_relations && !want_ate) || a.trajectory_path.empty())) {
+    std::fprintf(stderr, "sdpslam evaluate: --segments needs --trajectory and --relations or --ground-truth\n");
     return kExitUsage;
   }
   if (!a.plot_path.empty() && !want_relations) {
@@ -542,8 +585,9 @@ std::function<int()> setup_evaluate(CLI::App& app) {
   app.add_option("--plot", args->plot_path,
                  "with --relations: draw each relation's translational error over time into this PNG file");
   app.add_option("--segments", args->segments_path,
-                 "with --relations and --trajectory: the run's segments.tsv; fit each segment's frame to the relations "
-                 "(how much of the error lies in the frames' placement, how much within the submaps)");
+                 "with --trajectory: the run's segments.tsv; with --relations, fit each segment's frame to the "
+                 "relations (how much of the error lies in the frames' placement, how much within the submaps); with "
+                 "--ground-truth, align each segment on its own and measure its drift from first to last scan");
   app.add_option("--stamp-tolerance-us", args->tolerance_us,
                  "stamps closer than this name the same scan when not equal (default 1000)");
   return [args] { return run_evaluate(*args); };
