@@ -15,7 +15,10 @@
 #     SE(2) alignment, m) and the relative error per 10 m of path (`sdpslam evaluate`'s
 #     --rpe-m: the local drift, and its along-track part, whatever the loops did), and
 #     the loop constraints the run used, checked against that ground truth (`evaluate
-#     --loops`: "wrong loops used" counts those 2 m or more off, over all seeds).
+#     --loops`: "wrong loops used" counts those 2 m or more off, over all seeds), and the
+#     drift of the run's submaps, each from its first scan to its last, per 10 m of path
+#     (evaluate --segments), beside the simulated odometry's drift over the same
+#     stretches: a bottom level that drifts more than its odometry loses to it;
 #     `simulate` has two built-in worlds: "paper", the paper's nested
 #     28 m / 80 m loops, and "large", a 203 m x 123 m building with 2.26 km of nested loops,
 #     an open hall and featureless corridors, scanned by a 270 deg 30 m laser (its log is
@@ -85,8 +88,19 @@ if [ "${1:-}" = --job ]; then
       set -- --ground-truth "$dir/sim/ground_truth.txt"
       # sdp mode writes its loop constraints: checked against the ground truth too.
       if [ -f "$dir/loops.tsv" ]; then set -- "$@" --loops "$dir/loops.tsv"; fi
+      # ... and its segments: the submaps' own drift is measured too, and the odometry's
+      # over the same stretches.
+      if [ -f "$dir/segments.tsv" ]; then
+        set -- "$@" --segments "$dir/segments.tsv"
+        if "$bin" evaluate --ground-truth "$dir/sim/ground_truth.txt" --trajectory "$dir/sim/odometry.txt" \
+             --segments "$dir/segments.tsv" --rpe-m 0 --json "$dir/evaluate_odometry.json" \
+             > "$dir/evaluate_odometry.txt" 2>&1; then :; else
+          status="evaluate_failed(odometry, exit $?)"
+        fi
+      fi
     fi
-    if "$bin" evaluate "$@" --trajectory "$dir/trajectory.txt" --json "$dir/evaluate.json" \
+    if [ "$status" != ok ]; then :
+    elif "$bin" evaluate "$@" --trajectory "$dir/trajectory.txt" --json "$dir/evaluate.json" \
          > "$dir/evaluate.txt" 2>&1; then :; else
       status="evaluate_failed(exit $?)"
     fi
@@ -132,13 +146,15 @@ if kind == "log":
 used = ((ev or {}).get("loops") or {}).get("used") or {}
 fit = (((ev or {}).get("relations") or {}).get("frame_fit") or {}).get("all") or {}
 placement = repr(fit["mean_m"] - fit["fitted_mean_m"]) if "mean_m" in fit else "NA"
+seg = (ev or {}).get("segment_drift") or {}
+odo = ((load("evaluate_odometry.json") if status == "ok" else None) or {}).get("segment_drift") or {}
 print("\t".join([kind, name, seed, metric, value, status, get(t, "cpu_time_s"), get(t, "scan_cpu_ms_max"),
                  get(m, "arena_bytes"), get(t, "peak_rss_kib"), get(t, "wall_time_s"), refusals, nonzero, d,
                  get(rpe, "mean_m"), scale, get(used, "count"), get(used, "wrong"),
                  get(obs, "writes_shortened"), get(obs, "shortest_write_reach_m"), get(t, "scans_cpu_over_100ms"),
-                 placement]))
+                 placement, get(seg, "drift_per_10m_m"), get(odo, "drift_per_10m_m")]))
 EOF
-  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' \
+  printf '%s\t%s\t%s\t%s\tNA\trecord_failed\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' \
     "$kind" "$name" "$seed" "$metric" "$dir" > "$dir/record.tsv.tmp"
   mv "$dir/record.tsv.tmp" "$dir/record.tsv"
   value=$(cut -f5 "$dir/record.tsv"); status=$(cut -f6 "$dir/record.tsv")
@@ -209,11 +225,11 @@ xargs -P "$jobs" -L 1 sh "$self" --job < "$joblist" || echo "accuracy.sh: a job 
 
 # runs.tsv in job order; a job that left no record counts as failed.
 runs="$out/runs.tsv"
-printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\twrites_shortened\tshortest_write_reach_m\tscans_cpu_over_100ms\tplacement_m\n' > "$runs"
+printf 'kind\tname\tseed\tmetric\tvalue_m\tstatus\tcpu_time_s\tscan_cpu_ms_max\tarena_bytes\tpeak_rss_kib\twall_time_s\trefusals\trefusal_kinds\tdir\trpe_m\trpe_scale\tloops_used\tloops_used_wrong\twrites_shortened\tshortest_write_reach_m\tscans_cpu_over_100ms\tplacement_m\tsubmap_drift_m\todometry_drift_m\n' > "$runs"
 while read -r kind name seed; do
   rec="$out/${kind}s/$name/$seed/record.tsv"
   if [ -f "$rec" ]; then cat "$rec"; else
-    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
+    printf '%s\t%s\t%s\tNA\tNA\tno_record\tNA\tNA\tNA\tNA\tNA\tNA\t-\t%s\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\tNA\n' "$kind" "$name" "$seed" "${rec%/*}"
   fi
 done < "$joblist" >> "$runs"
 
@@ -231,9 +247,9 @@ def fmt(v, f):
 def nums(rs, k):
     return [x for x in (num(r[k]) for r in rs) if x is not None]
 out = ["| name | metric | mean | worst (seed) | per seed | frames' placement m | drift m per 10 m, mean (worst) "
-       "| along-track % | wrong loops used | CPU s mean | CPU s max | worst scan ms | scans over 100 ms | state bytes "
+       "| submaps' drift m per 10 m (odometry's) | along-track % | wrong loops used | CPU s mean | CPU s max | worst scan ms | scans over 100 ms | state bytes "
        "| peak RSS MiB | refusals |",
-       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for (kind, name), rs in groups.items():
     metric = "relations m" if kind == "log" else "ATE m"
     ok = [(num(r["value_m"]), r["seed"]) for r in rs if num(r["value_m"]) is not None]
@@ -262,10 +278,14 @@ for (kind, name), rs in groups.items():
     # what the submaps' placement (loop closure) costs, mean over the seeds.
     place = nums(rs, "placement_m")
     placement = "-" if not place else "%.3f" % (sum(place) / len(place))
+    # The submaps' drift from first to last scan, and the odometry's over the same
+    # stretches, per 10 m of path, mean over the seeds (worlds only: a ground truth).
+    sub, odo = nums(rs, "submap_drift_m"), nums(rs, "odometry_drift_m")
+    submaps = "-" if not sub else "%.3f (%s)" % (sum(sub) / len(sub), fmt(sum(odo) / len(odo) if odo else None, "%.3f"))
     # Loop constraints used at the end that the ground truth says are 2 m or more off.
     used, wrong = nums(rs, "loops_used"), nums(rs, "loops_used_wrong")
     loops = "-" if not used else "%d of %d" % (sum(wrong), sum(used))
-    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, placement, drift, along, loops,
+    out.append("| %s |" % " | ".join([name, metric, mean_s, worst, per, placement, drift, submaps, along, loops,
         fmt(sum(cpu) / len(cpu) if cpu else None, "%.1f"), fmt(max(cpu) if cpu else None, "%.1f"),
         fmt(max(scan) if scan else None, "%.1f"), fmt(sum(slow) if slow else None, "%d"),
         fmt(max(arena) if arena else None, "%d"),
