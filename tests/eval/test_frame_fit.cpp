@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rectangle_run.h"
 #include "sdpslam/eval/frame_fit.h"
 #include "sdpslam/eval/relations.h"
 
@@ -19,26 +20,10 @@ using sdpslam::io::StampedPose;
 
 namespace {
 
-constexpr std::int64_t kStart_us = 1000000000LL;
-constexpr std::int64_t kPeriod_us = 100000;
 constexpr std::size_t kPerSegment = 47U;
 
 // A robot driving three times round a 6 m × 4 m rectangle, one scan every 10 cm.
-std::vector<StampedPose> truth() {
-  std::vector<StampedPose> p;
-  Pose2 pose{0.0, 0.0, 0.0};
-  const double side_m[4] = {6.0, 4.0, 6.0, 4.0};
-  for (int lap = 0; lap < 3; ++lap) {
-    for (double side : side_m) {
-      for (int k = 0; k < static_cast<int>(side / 0.1 + 0.5); ++k) {
-        p.push_back({kStart_us + static_cast<std::int64_t>(p.size()) * kPeriod_us, pose});
-        pose = pose.compose(Pose2{0.1, 0.0, 0.0});
-      }
-      pose = pose.compose(Pose2{0.0, 0.0, 3.14159265358979323846 / 2.0});
-    }
-  }
-  return p;
-}
+std::vector<StampedPose> truth() { return sdpslam::test::rectangle_run(3); }
 
 // Consecutive scans, and each scan with the same place one and two laps later.
 std::vector<Relation> relations_of(const std::vector<StampedPose>& gt) {
@@ -57,11 +42,7 @@ std::vector<Relation> relations_of(const std::vector<StampedPose>& gt) {
 }
 
 std::vector<SegmentStart> segments_of(const std::vector<StampedPose>& gt) {
-  std::vector<SegmentStart> s;
-  for (std::size_t i = 0; i < gt.size(); i += kPerSegment) {
-    s.push_back(SegmentStart{static_cast<std::uint32_t>(s.size()), gt[i].stamp_us - 1});
-  }
-  return s;
+  return sdpslam::test::segments_every(gt, kPerSegment);
 }
 
 // Each segment's scans moved rigidly: turned about the segment's first scan and shifted,

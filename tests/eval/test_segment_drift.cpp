@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rectangle_run.h"
 #include "sdpslam/eval/ate.h"
 #include "sdpslam/eval/segment_drift.h"
 
@@ -16,34 +17,14 @@ using sdpslam::io::StampedPose;
 
 namespace {
 
-constexpr std::int64_t kStart_us = 1000000000LL;
-constexpr std::int64_t kPeriod_us = 100000;
 constexpr std::size_t kPerSegment = 40U;
 
 // Twice round a 6 m × 4 m rectangle, one scan every 10 cm: 400 scans, 10 segments of
 // 4 m of path each (every one has a chord of at least 2.8 m).
-std::vector<StampedPose> truth() {
-  std::vector<StampedPose> p;
-  Pose2 pose{0.0, 0.0, 0.0};
-  const double side_m[4] = {6.0, 4.0, 6.0, 4.0};
-  for (int lap = 0; lap < 2; ++lap) {
-    for (double side : side_m) {
-      for (int k = 0; k < static_cast<int>(side / 0.1 + 0.5); ++k) {
-        p.push_back({kStart_us + static_cast<std::int64_t>(p.size()) * kPeriod_us, pose});
-        pose = pose.compose(Pose2{0.1, 0.0, 0.0});
-      }
-      pose = pose.compose(Pose2{0.0, 0.0, 3.14159265358979323846 / 2.0});
-    }
-  }
-  return p;
-}
+std::vector<StampedPose> truth() { return sdpslam::test::rectangle_run(2); }
 
 std::vector<SegmentStart> segments_of(const std::vector<StampedPose>& gt) {
-  std::vector<SegmentStart> s;
-  for (std::size_t i = 0; i < gt.size(); i += kPerSegment) {
-    s.push_back(SegmentStart{static_cast<std::uint32_t>(s.size()), gt[i].stamp_us - 1});
-  }
-  return s;
+  return sdpslam::test::segments_every(gt, kPerSegment);
 }
 
 // Each segment's scans expressed in its first scan's frame, changed by `within` (the
